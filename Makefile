@@ -1,0 +1,25 @@
+# The two commands of the quick start are `make run` and `make test`; both bootstrap `.venv` first.
+SHELL := /bin/bash
+VENV := .venv/bin
+export MUJOCO_GL ?= egl
+export PYOPENGL_PLATFORM ?= egl
+
+.PHONY: bootstrap run test test-slow lint bench-rtf
+
+bootstrap:
+	@scripts/bootstrap.sh
+
+run: bootstrap
+	$(VENV)/laserpick serve
+
+test: bootstrap
+	$(VENV)/python -m pytest -q
+
+test-slow: bootstrap
+	$(VENV)/python -m pytest -q -m slow
+
+lint: bootstrap
+	$(VENV)/ruff check . && $(VENV)/ruff format --check .
+
+bench-rtf: bootstrap
+	$(VENV)/python bench/realtime_factor.py

@@ -1,0 +1,159 @@
+"""Named dimensions and hardware limits of the simulated robot: the one place they live.
+
+Everything is SI (metres, radians, seconds, kilograms, newtons). Poses are given in the
+scooter's `base` frame: x forward, y left, z up, origin on the floor under the centre of
+the rear axle. The model builder, the controllers and the safety checks all read from here,
+so a limit is never restated elsewhere.
+
+Sources: UR5 DH parameters and datasheet (Universal Robots); Robotiq 2F-85 datasheet;
+paper 004 (Wang et al.) section 3 and 5.1 for the scooter, sensors, laser and projector.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+# --- UR5 arm ---------------------------------------------------------------------------------
+
+#: Standard DH parameters of the UR5 (metres and radians), joints 1..6.
+UR5_D = (0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823)
+UR5_A = (0.0, -0.425, -0.39225, 0.0, 0.0, 0.0)
+UR5_ALPHA = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
+
+UR5_JOINT_NAMES = (
+    "shoulder_pan",
+    "shoulder_lift",
+    "elbow",
+    "wrist_1",
+    "wrist_2",
+    "wrist_3",
+)
+#: Joint position limits (rad): +-2pi everywhere except the elbow, +-pi.
+UR5_Q_MIN = np.array([-2 * math.pi, -2 * math.pi, -math.pi, -2 * math.pi, -2 * math.pi, -2 * math.pi])
+UR5_Q_MAX = -UR5_Q_MIN
+#: Maximum joint speed of the UR5 (rad/s), all joints.
+UR5_QD_MAX = 3.14
+#: Joint acceleration limit used for time parametrization (rad/s^2).
+UR5_QDD_MAX = 3.0
+#: Link masses (kg) from the UR5 datasheet: base, shoulder, upper arm, forearm, wrist 1, 2, 3.
+UR5_LINK_MASSES = (4.0, 3.7, 8.393, 2.275, 1.219, 1.219, 0.1879)
+#: Capsule radii (m) of the collision geometry of each link.
+UR5_LINK_RADII = (0.075, 0.06, 0.054, 0.045, 0.045, 0.045, 0.04)
+#: Peak joint torques (N m): 150 for the base joints, 28 for the wrists (datasheet sizes).
+UR5_TORQUE_MAX = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
+
+#: Folded to the right of the scooter front, gripper down, out of the cameras' way (rad).
+UR5_HOME_Q = np.array([-1.5708, -2.0, 2.6, -2.17, -1.5708, 0.0])
+
+# --- Gripper (Robotiq 2F-85-like parallel jaw) ------------------------------------------------
+
+GRIPPER_STROKE = 0.085  #: full opening between the pads (m)
+GRIPPER_FORCE_MAX = 100.0  #: closing force limit per finger (N); the 2F-85 does 20-235 N
+GRIPPER_SPEED = 0.15  #: finger closing speed (m/s), the 2F-85's upper figure
+GRIPPER_BASE_LENGTH = 0.10  #: flange to finger root (m), the gripper body
+GRIPPER_FINGER_LENGTH = 0.05  #: finger root to fingertip (m)
+GRIPPER_PAD_DEPTH = 0.022  #: pad extent along the approach axis (m)
+GRIPPER_PAD_WIDTH = 0.022  #: pad extent along the hand axis (m)
+GRIPPER_PAD_THICKNESS = 0.008  #: pad thickness along the closing axis (m)
+GRIPPER_BODY_WIDTH = 0.09  #: palm housing across the closing axis (m)
+GRIPPER_BODY_DEPTH = 0.06  #: palm housing along the hand axis (m)
+#: Flange to TCP (m): the TCP sits midway between the pad centres.
+GRIPPER_TCP_OFFSET = GRIPPER_BASE_LENGTH + GRIPPER_FINGER_LENGTH - GRIPPER_PAD_DEPTH / 2
+GRIPPER_MASS = 0.9  #: kg, the 2F-85 datasheet
+PAD_FRICTION = (1.5, 0.02, 0.001)  #: sliding, torsional, rolling: rubber pads
+#: A finger gap below this (m) with the gripper commanded closed means it closed on nothing.
+GRIPPER_EMPTY_GAP = 0.003
+#: Summed pad contact normal force (N) above which the gripper counts as holding.
+GRIPPER_HOLD_FORCE = 2.0
+
+# --- Scooter (Merits Pioneer 10-like) ---------------------------------------------------------
+
+SCOOTER_LENGTH = 1.2
+SCOOTER_WIDTH = 0.6
+SCOOTER_REAR_OVERHANG = 0.15  #: rear axle to the back edge (m)
+SCOOTER_DECK_HEIGHT = 0.30  #: top of the deck above the floor (m)
+SCOOTER_DECK_THICKNESS = 0.12
+WHEEL_RADIUS = 0.13
+WHEEL_WIDTH = 0.08
+WHEEL_TRACK = 0.56  #: distance between the rear wheel centres (m)
+CASTER_X = 0.95  #: front caster position (m)
+CASTER_RADIUS = 0.08
+SEAT_X = 0.15
+SEAT_HEIGHT = 0.62  #: seat cushion top (m)
+SEAT_BACK_HEIGHT = 1.05
+TILLER_X = 0.86  #: steering column position (m)
+HANDLEBAR_HEIGHT = 0.92
+HANDLEBAR_WIDTH = 0.55
+#: Basket on the handlebars: centre (m, base frame), inner size (m), wall thickness (m).
+BASKET_CENTER = np.array([1.00, 0.12, 0.80])
+BASKET_INNER = np.array([0.20, 0.32, 0.16])
+BASKET_WALL = 0.008
+SCOOTER_MASS = 110.0
+
+#: Base drive limits: linear and angular speed and acceleration.
+BASE_V_MAX = 1.0  #: m/s (a scooter can do more; this is the indoor limit)
+BASE_W_MAX = 1.0  #: rad/s
+BASE_A_MAX = 0.6  #: m/s^2
+BASE_ALPHA_MAX = 1.5  #: rad/s^2
+
+#: Arm mount: the UR5 base frame in `base` (m). Front of the scooter, right of the tiller,
+#: low enough to reach the floor and high enough for a 100 cm shelf.
+ARM_MOUNT_POS = np.array([1.10, -0.28, 0.50])
+#: rad. The DH base frame's -x is the direction the stretched arm points at q = 0, so a half
+#: turn makes shoulder_pan = 0 face forward.
+ARM_MOUNT_YAW = math.pi
+
+# --- Depth sensors (004 section 5.1) ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CameraMount:
+    """A depth sensor on the scooter: position in `base` (m), pitch down and yaw inward (rad)."""
+
+    name: str
+    pos: tuple[float, float, float]
+    pitch_down: float
+    yaw: float  #: rotation about +z; positive turns left
+
+
+SENSOR_X = 0.92  #: the sensor posts stand just behind the basket (m)
+SENSOR_LOW_HEIGHT = 1.14
+SENSOR_HIGH_HEIGHT = 1.56
+SENSOR_GROUP_SPACING = 0.63
+SENSOR_INWARD = math.radians(20.0)
+_Y = SENSOR_GROUP_SPACING / 2
+CAMERA_MOUNTS = (
+    # Left group (y > 0) turns right (negative yaw) to look inward; right group mirrors it.
+    CameraMount("left_25", (SENSOR_X, _Y, SENSOR_LOW_HEIGHT), math.radians(25), -SENSOR_INWARD),
+    CameraMount("left_55", (SENSOR_X, _Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), -SENSOR_INWARD),
+    CameraMount("right_25", (SENSOR_X, -_Y, SENSOR_LOW_HEIGHT), math.radians(25), SENSOR_INWARD),
+    CameraMount("right_55", (SENSOR_X, -_Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), SENSOR_INWARD),
+    # The fifth sensor stands higher, on the left post, to see shelf tops and tall tables.
+    CameraMount("high_44", (SENSOR_X - 0.1, _Y, SENSOR_HIGH_HEIGHT), math.radians(44), -SENSOR_INWARD),
+)
+#: Structure-sensor-like intrinsics: 640x480, about 58 deg x 45 deg field of view.
+DEPTH_WIDTH = 640
+DEPTH_HEIGHT = 480
+DEPTH_FOVY = math.radians(45.0)  #: vertical field of view; horizontal follows from square pixels
+DEPTH_MIN = 0.35  #: m, nearest valid depth
+DEPTH_MAX = 3.5  #: m, farthest valid depth
+
+# --- Projector and laser ------------------------------------------------------------------
+
+#: The projector sits above the tiller, looking forward and down at the workspace.
+PROJECTOR_POS = (0.80, 0.0, 1.45)
+PROJECTOR_PITCH_DOWN = math.radians(40.0)
+PROJECTOR_WIDTH = 1280  #: pixels (EPSON H801A-like WXGA panel)
+PROJECTOR_HEIGHT = 800
+PROJECTOR_FOVY = math.radians(32.0)
+
+#: The laser pointer is held by the seated user, roughly at hand height in front of the seat.
+LASER_ORIGIN = (0.55, 0.12, 0.95)
+LASER_BEAM_SEPARATION = 0.015  #: m between the two parallel beams
+LASER_MAX_RANGE = 5.0  #: m
+LASER_YAW_LIMIT = math.radians(80.0)
+LASER_PITCH_MIN = math.radians(-85.0)  #: negative = down
+LASER_PITCH_MAX = math.radians(30.0)

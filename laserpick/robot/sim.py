@@ -1,0 +1,486 @@
+"""The MuJoCo loop: one thread owns MjData and steps it; everyone else sends commands or reads
+snapshots.
+
+Real-time mode steps at `settings.sim.rate_hz` against the wall clock, in chunks of 20 ms, and
+can be paused. Headless mode has no thread: the caller steps it as fast as it can, and the
+result depends only on the commands and the seed.
+
+Commands (`execute`, `move_tcp`, `gripper`, `drive`, `stop`, ...) may come from any thread.
+They are queued and applied by the sim thread before its next physics step, so the e-stop acts
+within one step (2 ms at 500 Hz). Nothing a command does can raise inside the loop: a command
+that fails marks its handle failed and the loop steps on.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal
+
+import mujoco
+import numpy as np
+
+from laserpick.pipeline.trajectory import Trajectory
+from laserpick.robot import dims
+from laserpick.robot.arm_control import CartesianController, TrajectoryTracker
+from laserpick.robot.model import ModelInfo, build_arm_model, build_sim_model
+from laserpick.robot.scenes import Scene
+from laserpick.settings import Settings, get_settings
+
+log = logging.getLogger(__name__)
+
+MotionStatus = Literal["running", "done", "stopped", "failed"]
+
+#: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
+_CHUNK_STEPS = 10
+
+
+class MotionHandle:
+    """The outcome of one commanded arm motion, shared between the caller and the sim thread."""
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        self.status: MotionStatus = "running"
+        self.message = ""
+        self._done = threading.Event()
+
+    def _finish(self, status: MotionStatus, message: str = "") -> None:
+        if self._done.is_set():
+            return
+        self.status, self.message = status, message
+        self._done.set()
+
+    def done(self) -> bool:
+        return self._done.is_set()
+
+    def wait(self, timeout: float | None = None) -> MotionStatus:
+        """Block until the motion ends (or `timeout` seconds of wall time pass)."""
+        self._done.wait(timeout)
+        return self.status
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """A consistent copy of the simulation state at one instant, safe to read from any thread.
+
+    Poses are in `world`. `base_pose` is the scooter's (x, y, yaw) in `world`.
+    """
+
+    time: float
+    qpos: np.ndarray
+    qvel: np.ndarray
+    xpos: np.ndarray  #: (nbody, 3) body positions
+    xquat: np.ndarray  #: (nbody, 4) body orientations (w, x, y, z)
+    arm_q: np.ndarray  #: (6,) rad
+    arm_qd: np.ndarray  #: (6,) rad/s
+    base_pose: np.ndarray  #: (3,) x, y (m), yaw (rad)
+    base_velocity: np.ndarray  #: (2,) forward speed (m/s), turn rate (rad/s)
+    gripper_width: float  #: opening between the pads (m)
+    gripper_force: float  #: summed normal force on the pads (N)
+    gripper_closed: bool  #: the last gripper command was "close"
+    holding: bool
+    estopped: bool
+    moving: bool  #: an arm motion is in progress
+    rtf: float  #: measured real-time factor of the loop (sim seconds per wall second)
+
+
+class Simulation:
+    """Owner of MjModel/MjData and the control laws that drive them."""
+
+    def __init__(
+        self,
+        scene: Scene | None,
+        *,
+        realtime: bool = True,
+        settings: Settings | None = None,
+    ) -> None:
+        self.settings = settings or get_settings()
+        self.scene = scene
+        self.realtime = realtime
+        self.model = build_sim_model(scene)
+        self.data = mujoco.MjData(self.model)
+        self.info = ModelInfo.of(self.model)
+        self.arm_model = build_arm_model()
+        self.dt = float(self.model.opt.timestep)
+        self._control_every = max(1, round(self.settings.sim.rate_hz / self.settings.sim.control_rate_hz))
+        self._lock = threading.RLock()
+        self._inbox: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._thread: threading.Thread | None = None
+        self._running = threading.Event()
+        self._paused = threading.Event()
+        self._snapshot_listeners: list[Callable[[Snapshot], None]] = []
+        self._rtf = 0.0
+        self.reset()
+
+    # --- lifecycle ------------------------------------------------------------------------------
+
+    def reset(self) -> None:
+        """Back to the scene's start: scooter at its start pose, arm home, gripper open."""
+        with self._lock:
+            m, d, info = self.model, self.data, self.info
+            mujoco.mj_resetData(m, d)
+            if self.scene is not None:
+                x, y, yaw = self.scene.scooter_pose
+                d.qpos[info.base_qpos] = [x, y, yaw]
+            d.qpos[info.arm_qpos] = dims.UR5_HOME_Q
+            d.qpos[info.finger_qpos] = dims.GRIPPER_STROKE / 2
+            self._q_set = dims.UR5_HOME_Q.copy()
+            d.ctrl[info.arm_ctrl] = self._q_set
+            self._grip_target = dims.GRIPPER_STROKE / 2
+            self._grip_set = self._grip_target
+            self._grip_closed = False
+            d.ctrl[info.gripper_ctrl] = self._grip_set
+            self._motion: TrajectoryTracker | CartesianController | None = None
+            self._handle: MotionHandle | None = None
+            self._cartesian = CartesianController(self.arm_model)
+            self._cart_tol = (0.001, math.radians(0.5))
+            self._cart_deadline = 0.0
+            self._drive_cmd = np.zeros(2)
+            self._drive_deadline = -1.0
+            self._drive_now = np.zeros(2)
+            self.estopped = False
+            self._steps = 0
+            mujoco.mj_forward(m, d)
+            self._publish()
+
+    def start(self) -> None:
+        """Start the real-time loop thread."""
+        if not self.realtime:
+            raise RuntimeError("a headless simulation is stepped by its caller; use step()")
+        if self._thread is not None:
+            return
+        self._running.set()
+        self._thread = threading.Thread(target=self._loop, name="laserpick-sim", daemon=True)
+        self._thread.start()
+
+    def close(self) -> None:
+        """Stop the loop thread (if any) and wait for it."""
+        self._running.clear()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+            self._thread = None
+
+    def pause(self) -> None:
+        self._paused.set()
+
+    def resume(self) -> None:
+        self._paused.clear()
+
+    @property
+    def paused(self) -> bool:
+        return self._paused.is_set()
+
+    def on_snapshot(self, fn: Callable[[Snapshot], None]) -> None:
+        """Call `fn(snapshot)` from the sim thread after each published chunk. Keep it quick."""
+        self._snapshot_listeners.append(fn)
+
+    # --- reading --------------------------------------------------------------------------------
+
+    def snapshot(self) -> Snapshot:
+        """The latest published state (a new object each chunk; never mutated)."""
+        return self._snap
+
+    # --- commands (any thread) -------------------------------------------------------------------
+
+    def execute(self, traj: Trajectory) -> MotionHandle:
+        """Track a joint trajectory from now. Refused while e-stopped."""
+        handle = MotionHandle("trajectory")
+
+        def apply() -> None:
+            if self._refuse_when_stopped(handle):
+                return
+            start = self.data.qpos[self.info.arm_qpos]
+            if np.max(np.abs(traj.q[0] - start)) > 0.05:
+                handle._finish("failed", "trajectory does not start at the current joint angles")
+                return
+            self._replace_motion(TrajectoryTracker(traj, self.data.time), handle)
+
+        self._post(apply)
+        return handle
+
+    def move_tcp(self, T_base_tcp: np.ndarray, timeout: float = 10.0) -> MotionHandle:
+        """Move the TCP to a pose in `base` with mink IK; fails after `timeout` sim seconds."""
+        handle = MotionHandle("cartesian")
+        target = np.array(T_base_tcp, dtype=float)
+
+        def apply() -> None:
+            if self._refuse_when_stopped(handle):
+                return
+            try:
+                self._cartesian.set_target(target)
+            except ValueError as exc:
+                handle._finish("failed", str(exc))
+                return
+            self._cart_deadline = self.data.time + timeout
+            self._replace_motion(self._cartesian, handle)
+
+        self._post(apply)
+        return handle
+
+    def gripper(self, close: bool) -> None:
+        """Close (to the force limit) or open fully. Opening is allowed under e-stop."""
+
+        def apply() -> None:
+            if close and self.estopped:
+                return
+            self._grip_closed = close
+            self._grip_target = 0.0 if close else dims.GRIPPER_STROKE / 2
+
+        self._post(apply)
+
+    def drive(self, v: float, w: float, duration: float = 0.5) -> None:
+        """Drive the base at v (m/s) and w (rad/s) for at most `duration` s (a dead-man).
+
+        Values are clamped to the base limits in `dims`; the ramp respects its acceleration
+        limits. Refused while e-stopped.
+        """
+        if not (math.isfinite(v) and math.isfinite(w) and math.isfinite(duration)):
+            raise ValueError("drive command must be finite")
+        v = float(np.clip(v, -dims.BASE_V_MAX, dims.BASE_V_MAX))
+        w = float(np.clip(w, -dims.BASE_W_MAX, dims.BASE_W_MAX))
+        duration = float(np.clip(duration, 0.0, 0.5))
+
+        def apply() -> None:
+            if self.estopped:
+                return
+            self._drive_cmd = np.array([v, w])
+            self._drive_deadline = self.data.time + duration
+
+        self._post(apply)
+
+    def halt(self) -> None:
+        """Stop arm and base motion now, without latching (cancel, watchdog)."""
+        self._post(lambda: self._halt("stopped", "halted"))
+
+    def stop(self) -> None:
+        """E-stop: halt arm and base within one step and refuse motion until `reset_stop`."""
+
+        def apply() -> None:
+            self.estopped = True
+            self._halt("stopped", "e-stop")
+
+        self._post(apply)
+
+    def reset_stop(self) -> None:
+        """Release a latched e-stop."""
+
+        def apply() -> None:
+            self.estopped = False
+
+        self._post(apply)
+
+    def call(self, fn: Callable[[mujoco.MjModel, mujoco.MjData], object]) -> object:
+        """Run `fn(model, data)` in the sim thread between steps and return its result."""
+        box: list[object] = []
+        err: list[BaseException] = []
+        done = threading.Event()
+
+        def apply() -> None:
+            try:
+                box.append(fn(self.model, self.data))
+            except BaseException as exc:  # handed back to the caller, never raised in the loop
+                err.append(exc)
+            done.set()
+
+        self._post(apply)
+        if self._thread is not None:
+            done.wait(5.0)
+        if err:
+            raise err[0]
+        return box[0] if box else None
+
+    # --- headless stepping -----------------------------------------------------------------------
+
+    def step(self, n: int = 1) -> None:
+        """Advance n physics steps in the calling thread (headless mode, or a paused loop)."""
+        if self._thread is not None and not self.paused:
+            raise RuntimeError("the real-time loop is running; pause it before stepping by hand")
+        with self._lock:
+            for _ in range(n):
+                self._step_once()
+            self._publish()
+
+    def run_until(self, handle: MotionHandle, max_seconds: float) -> MotionStatus:
+        """Headless: step until `handle` finishes or `max_seconds` of sim time pass."""
+        end = self.data.time + max_seconds
+        while not handle.done() and self.data.time < end:
+            self.step(_CHUNK_STEPS)
+        return handle.status
+
+    def settle(self, seconds: float) -> None:
+        """Headless: step for `seconds` of sim time."""
+        self.step(max(1, round(seconds / self.dt)))
+
+    # --- the loop ----------------------------------------------------------------------------------
+
+    def _post(self, fn: Callable[[], None]) -> None:
+        if self._thread is None:
+            with self._lock:
+                fn()
+        else:
+            self._inbox.put(fn)
+
+    def _loop(self) -> None:
+        chunk_sim = _CHUNK_STEPS * self.dt
+        wall0, sim0 = time.perf_counter(), self.data.time
+        rtf_wall, rtf_sim = wall0, sim0
+        while self._running.is_set():
+            if self._paused.is_set():
+                self._drain()
+                time.sleep(0.01)
+                wall0, sim0 = time.perf_counter(), self.data.time
+                continue
+            with self._lock:
+                for _ in range(_CHUNK_STEPS):
+                    self._step_once()
+            self._publish()
+            now = time.perf_counter()
+            if now - rtf_wall >= 1.0:
+                self._rtf = (self.data.time - rtf_sim) / (now - rtf_wall)
+                rtf_wall, rtf_sim = now, self.data.time
+            lag = (wall0 + (self.data.time - sim0)) - now
+            if lag > 0:
+                time.sleep(lag)
+            elif lag < -10 * chunk_sim:
+                # Fell behind (a slow machine, a debugger): catch up from here, not in a burst.
+                wall0, sim0 = now, self.data.time
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                fn = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                fn()
+            except Exception:  # a bad command must never take the loop down
+                log.exception("command failed in the sim thread")
+
+    def _step_once(self) -> None:
+        self._drain()
+        if self._steps % self._control_every == 0:
+            self._control_tick()
+        mujoco.mj_step(self.model, self.data)
+        self._steps += 1
+
+    def _control_tick(self) -> None:
+        d, info = self.data, self.info
+        dt = self._control_every * self.dt
+        motion, handle = self._motion, self._handle
+        if motion is not None and handle is not None:
+            try:
+                if isinstance(motion, TrajectoryTracker):
+                    self._q_set = motion.setpoint(d.time)
+                    for event in motion.due_events(d.time):
+                        self._grip_closed = event.action == "close"
+                        self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
+                    if motion.finished(d.time):
+                        self._end_motion("done")
+                else:
+                    q = d.qpos[info.arm_qpos].copy()
+                    self._q_set = motion.step(self._q_set, dt)
+                    pos_err, rot_err = motion.error(q)
+                    if pos_err < self._cart_tol[0] and rot_err < self._cart_tol[1]:
+                        self._end_motion("done")
+                    elif d.time > self._cart_deadline:
+                        self._end_motion("failed", f"TCP target not reached ({pos_err * 1000:.1f} mm off)")
+            except Exception as exc:
+                log.exception("arm control failed")
+                self._halt("failed", f"arm control failed: {exc}")
+        d.ctrl[info.arm_ctrl] = self._q_set
+        # Gripper: ramp the finger setpoint at the gripper's speed.
+        step = dims.GRIPPER_SPEED / 2 * dt
+        self._grip_set += float(np.clip(self._grip_target - self._grip_set, -step, step))
+        d.ctrl[info.gripper_ctrl] = self._grip_set
+        self._drive_tick(dt)
+
+    def _drive_tick(self, dt: float) -> None:
+        d, info = self.data, self.info
+        want = self._drive_cmd if d.time < self._drive_deadline else np.zeros(2)
+        limits = np.array([dims.BASE_A_MAX, dims.BASE_ALPHA_MAX]) * dt
+        self._drive_now = self._drive_now + np.clip(want - self._drive_now, -limits, limits)
+        v, w = self._drive_now
+        yaw = d.qpos[info.base_qpos[2]]
+        d.ctrl[info.base_ctrl] = [v * math.cos(yaw), v * math.sin(yaw), w]
+
+    def _replace_motion(self, motion: TrajectoryTracker | CartesianController, handle: MotionHandle) -> None:
+        if self._handle is not None:
+            self._handle._finish("stopped", "replaced by a new motion")
+        self._motion, self._handle = motion, handle
+        self._q_set = self.data.qpos[self.info.arm_qpos].copy()
+
+    def _end_motion(self, status: MotionStatus, message: str = "") -> None:
+        if self._handle is not None:
+            self._handle._finish(status, message)
+        self._motion, self._handle = None, None
+
+    def _halt(self, status: MotionStatus, message: str) -> None:
+        """Hold the arm where it is and stop the base, at once."""
+        d, info = self.data, self.info
+        self._end_motion(status, message)
+        self._q_set = d.qpos[info.arm_qpos].copy()
+        d.ctrl[info.arm_ctrl] = self._q_set
+        # The UR5's brakes and the scooter's motor brake: motion stops this step.
+        d.qvel[info.arm_dof] = 0.0
+        d.qvel[info.base_dof] = 0.0
+        self._drive_cmd[:] = 0.0
+        self._drive_now[:] = 0.0
+        self._drive_deadline = -1.0
+        d.ctrl[info.base_ctrl] = 0.0
+
+    def _refuse_when_stopped(self, handle: MotionHandle) -> bool:
+        if self.estopped:
+            handle._finish("failed", "e-stop is latched; reset it first")
+            return True
+        return False
+
+    def _gripper_force(self) -> float:
+        d, pads = self.data, self.info.pad_geoms
+        total = 0.0
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.geom1 in pads or c.geom2 in pads:
+                mujoco.mj_contactForce(self.model, d, i, force)
+                total += abs(force[0])
+        return total
+
+    def _publish(self) -> None:
+        d, info = self.data, self.info
+        width = float(2 * d.qpos[info.finger_qpos[0]])
+        force = self._gripper_force()
+        yaw = float(d.qpos[info.base_qpos[2]])
+        vx, vy = d.qvel[info.base_dof[:2]]
+        snap = Snapshot(
+            time=float(d.time),
+            qpos=d.qpos.copy(),
+            qvel=d.qvel.copy(),
+            xpos=d.xpos.copy(),
+            xquat=d.xquat.copy(),
+            arm_q=d.qpos[info.arm_qpos].copy(),
+            arm_qd=d.qvel[info.arm_dof].copy(),
+            base_pose=d.qpos[info.base_qpos].copy(),
+            base_velocity=np.array(
+                [vx * math.cos(yaw) + vy * math.sin(yaw), d.qvel[info.base_dof[2]]]
+            ),
+            gripper_width=width,
+            gripper_force=force,
+            gripper_closed=self._grip_closed,
+            holding=self._grip_closed
+            and width > dims.GRIPPER_EMPTY_GAP
+            and force > dims.GRIPPER_HOLD_FORCE,
+            estopped=self.estopped,
+            moving=self._handle is not None,
+            rtf=self._rtf,
+        )
+        self._snap = snap
+        for fn in self._snapshot_listeners:
+            try:
+                fn(snap)
+            except Exception:
+                log.exception("snapshot listener failed")

@@ -1,0 +1,68 @@
+"""The one settings object: every tunable default, named, with where it came from.
+
+Values are read from `LASERPICK_*` environment variables; nested groups use a double
+underscore, e.g. `LASERPICK_SIM__RATE_HZ=250` or `LASERPICK_SENSOR__DEPTH_NOISE_K=0.002`.
+Hardware limits (joint ranges, speeds, stroke) are not settings: they are facts of the
+robot and live in `laserpick.robot.dims`.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from pydantic import BaseModel, Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+class SimSettings(BaseModel):
+    """The MuJoCo loop."""
+
+    rate_hz: float = Field(500.0, gt=0, description="Physics rate (Hz); the timestep is 1/rate.")
+    impratio: float = Field(
+        10.0, ge=1.0, description="Friction-to-normal impedance ratio; >= 10 holds a jaw grasp."
+    )
+    noslip_iterations: int = Field(
+        2, ge=0, description="Noslip solver passes that stop objects creeping out of a grasp."
+    )
+    control_rate_hz: float = Field(
+        100.0, gt=0, description="Arm controller rate (Hz): IK and trajectory setpoints."
+    )
+
+
+class SensorSettings(BaseModel):
+    """The depth sensor noise model, fitted loosely to structured-light sensors."""
+
+    depth_noise_k: float = Field(
+        1.5e-3, ge=0, description="Depth noise sigma = k * z^2 (1/m): 1.5 mm at 1 m."
+    )
+    edge_dropout_jump: float = Field(
+        0.04, ge=0, description="Depth jump (m) between neighbours that marks an edge pixel."
+    )
+    edge_dropout_prob: float = Field(
+        0.5, ge=0, le=1, description="Chance that an edge pixel reads no depth."
+    )
+    specular_dropout: float = Field(
+        0.5, ge=0, le=1, description="Fraction of a specular object's pixels that read no depth."
+    )
+    laser_spot_radius_px: float = Field(
+        2.5, gt=0, description="Apparent radius of a laser dot in the IR image (px)."
+    )
+    capture_rate_hz: float = Field(
+        2.0, gt=0, description="How often the live console captures all five cameras (Hz)."
+    )
+    seed: int = Field(0, description="Seed of the sensor noise generator.")
+
+
+class Settings(BaseSettings):
+    """All of laserpick's tunable defaults."""
+
+    model_config = SettingsConfigDict(env_prefix="LASERPICK_", env_nested_delimiter="__")
+
+    sim: SimSettings = SimSettings()
+    sensor: SensorSettings = SensorSettings()
+
+
+@lru_cache(maxsize=1)
+def get_settings() -> Settings:
+    """The process-wide settings, read once from the environment."""
+    return Settings()

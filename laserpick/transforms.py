@@ -1,0 +1,91 @@
+"""Small rigid-transform helpers shared by robot/ and pipeline/ (pure numpy).
+
+Quaternions are (w, x, y, z), MuJoCo's order. Homogeneous transforms are 4x4 float64.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def rotx(a: float) -> np.ndarray:
+    """Rotation by `a` radians about x."""
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def roty(a: float) -> np.ndarray:
+    """Rotation by `a` radians about y."""
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rotz(a: float) -> np.ndarray:
+    """Rotation by `a` radians about z."""
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def make_transform(R: np.ndarray | None = None, p: np.ndarray | None = None) -> np.ndarray:
+    """A 4x4 transform from a rotation matrix and a translation (identity where omitted)."""
+    T = np.eye(4)
+    if R is not None:
+        T[:3, :3] = R
+    if p is not None:
+        T[:3, 3] = p
+    return T
+
+
+def invert(T: np.ndarray) -> np.ndarray:
+    """Inverse of a rigid 4x4 transform."""
+    Ti = np.eye(4)
+    R = T[:3, :3]
+    Ti[:3, :3] = R.T
+    Ti[:3, 3] = -R.T @ T[:3, 3]
+    return Ti
+
+
+def quat_from_matrix(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) with w >= 0 for a 3x3 rotation matrix."""
+    m = np.asarray(R, dtype=float)
+    t = np.trace(m)
+    if t > 0:
+        s = math.sqrt(t + 1.0) * 2
+        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+    else:
+        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
+    qa = np.array(q)
+    qa /= np.linalg.norm(qa)
+    return qa if qa[0] >= 0 else -qa
+
+
+def matrix_from_quat(q: np.ndarray) -> np.ndarray:
+    """3x3 rotation matrix of a quaternion (w, x, y, z); need not be normalised."""
+    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def planar_pose(x: float, y: float, yaw: float) -> np.ndarray:
+    """4x4 transform of a pose on the floor: position (x, y, 0) and heading `yaw` about z."""
+    return make_transform(rotz(yaw), np.array([x, y, 0.0]))
+
+
+def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
+    """Angle (rad) of the rotation taking Ra to Rb."""
+    c = (np.trace(Ra.T @ Rb) - 1.0) / 2.0
+    return float(math.acos(max(-1.0, min(1.0, c))))
