@@ -44,6 +44,14 @@ class SensorSettings(BaseModel):
     specular_dropout: float = Field(
         0.5, ge=0, le=1, description="Fraction of a specular object's pixels that read no depth."
     )
+    specular_blob_px: float = Field(
+        12.0,
+        gt=0,
+        description="Size (px) of the blobs a specular object's missing depth comes in.",
+    )
+    ir_noise: float = Field(
+        2.0, ge=0, description="Sigma of the IR image's intensity noise (grey levels)."
+    )
     laser_spot_radius_px: float = Field(
         2.5, gt=0, description="Apparent radius of a laser dot in the IR image (px)."
     )

@@ -89,3 +89,13 @@ def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
     """Angle (rad) of the rotation taking Ra to Rb."""
     c = (np.trace(Ra.T @ Rb) - 1.0) / 2.0
     return float(math.acos(max(-1.0, min(1.0, c))))
+
+
+def pinhole_intrinsics(width: int, height: int, fovy: float) -> np.ndarray:
+    """K (3x3, px) of a MuJoCo-style camera with vertical field of view `fovy` (rad).
+
+    OpenCV pixel convention (pixel centres at integers, x right, y down). MuJoCo's optical
+    axis passes between the middle pixels, so the principal point is ((W-1)/2, (H-1)/2).
+    """
+    f = (height / 2.0) / math.tan(fovy / 2.0)
+    return np.array([[f, 0.0, (width - 1) / 2.0], [0.0, f, (height - 1) / 2.0], [0.0, 0.0, 1.0]])

@@ -32,7 +32,9 @@ UR5_JOINT_NAMES = (
     "wrist_3",
 )
 #: Joint position limits (rad): +-2pi everywhere except the elbow, +-pi.
-UR5_Q_MIN = np.array([-2 * math.pi, -2 * math.pi, -math.pi, -2 * math.pi, -2 * math.pi, -2 * math.pi])
+UR5_Q_MIN = np.array(
+    [-2 * math.pi, -2 * math.pi, -math.pi, -2 * math.pi, -2 * math.pi, -2 * math.pi]
+)
 UR5_Q_MAX = -UR5_Q_MIN
 #: Maximum joint speed of the UR5 (rad/s), all joints.
 UR5_QD_MAX = 3.14
@@ -45,8 +47,12 @@ UR5_LINK_RADII = (0.075, 0.06, 0.054, 0.045, 0.045, 0.045, 0.04)
 #: Peak joint torques (N m): 150 for the base joints, 28 for the wrists (datasheet sizes).
 UR5_TORQUE_MAX = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
 
-#: Folded to the right of the scooter front, gripper down, out of the cameras' way (rad).
-UR5_HOME_Q = np.array([-1.5708, -2.0, 2.6, -2.17, -1.5708, 0.0])
+#: Folded down and back along the scooter's right side, gripper down: out of the depth
+#: cameras' view of the workspace (only right_55 sees part of it) and clear of the basket (rad).
+UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
+#: Raised in front, elbow up, gripper pointing down with the TCP at about (1.40, -0.30, 0.85)
+#: in `base`: the transit pose between home and any grasp above the workspace (rad).
+UR5_READY_Q = np.array([-0.433, -1.705, 1.549, 1.727, 1.571, 1.138])
 
 # --- Gripper (Robotiq 2F-85-like parallel jaw) ------------------------------------------------
 
@@ -88,7 +94,7 @@ TILLER_X = 0.86  #: steering column position (m)
 HANDLEBAR_HEIGHT = 0.92
 HANDLEBAR_WIDTH = 0.55
 #: Basket on the handlebars: centre (m, base frame), inner size (m), wall thickness (m).
-BASKET_CENTER = np.array([1.00, 0.12, 0.80])
+BASKET_CENTER = np.array([0.99, 0.13, 0.80])
 BASKET_INNER = np.array([0.20, 0.32, 0.16])
 BASKET_WALL = 0.008
 SCOOTER_MASS = 110.0
@@ -101,7 +107,7 @@ BASE_ALPHA_MAX = 1.5  #: rad/s^2
 
 #: Arm mount: the UR5 base frame in `base` (m). Front of the scooter, right of the tiller,
 #: low enough to reach the floor and high enough for a 100 cm shelf.
-ARM_MOUNT_POS = np.array([1.10, -0.28, 0.50])
+ARM_MOUNT_POS = np.array([1.14, -0.30, 0.50])
 #: rad. The DH base frame's -x is the direction the stretched arm points at q = 0, so a half
 #: turn makes shoulder_pan = 0 face forward.
 ARM_MOUNT_YAW = math.pi
@@ -128,11 +134,17 @@ _Y = SENSOR_GROUP_SPACING / 2
 CAMERA_MOUNTS = (
     # Left group (y > 0) turns right (negative yaw) to look inward; right group mirrors it.
     CameraMount("left_25", (SENSOR_X, _Y, SENSOR_LOW_HEIGHT), math.radians(25), -SENSOR_INWARD),
-    CameraMount("left_55", (SENSOR_X, _Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), -SENSOR_INWARD),
+    CameraMount(
+        "left_55", (SENSOR_X, _Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), -SENSOR_INWARD
+    ),
     CameraMount("right_25", (SENSOR_X, -_Y, SENSOR_LOW_HEIGHT), math.radians(25), SENSOR_INWARD),
-    CameraMount("right_55", (SENSOR_X, -_Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), SENSOR_INWARD),
+    CameraMount(
+        "right_55", (SENSOR_X, -_Y, SENSOR_LOW_HEIGHT - 0.06), math.radians(55), SENSOR_INWARD
+    ),
     # The fifth sensor stands higher, on the left post, to see shelf tops and tall tables.
-    CameraMount("high_44", (SENSOR_X - 0.1, _Y, SENSOR_HIGH_HEIGHT), math.radians(44), -SENSOR_INWARD),
+    CameraMount(
+        "high_44", (SENSOR_X - 0.1, _Y, SENSOR_HIGH_HEIGHT), math.radians(44), -SENSOR_INWARD
+    ),
 )
 #: Structure-sensor-like intrinsics: 640x480, about 58 deg x 45 deg field of view.
 DEPTH_WIDTH = 640

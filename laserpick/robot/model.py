@@ -25,7 +25,7 @@ from laserpick.robot import dims
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT
 from laserpick.robot.scenes import Scene, add_scene_to_spec
 from laserpick.settings import get_settings
-from laserpick.transforms import quat_from_matrix, rotx, roty, rotz
+from laserpick.transforms import pinhole_intrinsics, quat_from_matrix, rotx, roty, rotz
 
 G = mujoco.mjtGeom
 J = mujoco.mjtJoint
@@ -79,10 +79,7 @@ def camera_rotation(pitch_down: float, yaw: float) -> np.ndarray:
 
 def depth_intrinsics() -> np.ndarray:
     """K (3x3, pixels) of every depth camera, from dims' resolution and vertical field of view."""
-    f = (dims.DEPTH_HEIGHT / 2) / math.tan(dims.DEPTH_FOVY / 2)
-    return np.array(
-        [[f, 0.0, dims.DEPTH_WIDTH / 2], [0.0, f, dims.DEPTH_HEIGHT / 2], [0.0, 0.0, 1.0]]
-    )
+    return pinhole_intrinsics(dims.DEPTH_WIDTH, dims.DEPTH_HEIGHT, dims.DEPTH_FOVY)
 
 
 def _geom(body: mujoco.MjsBody, name: str, kind: mujoco.mjtGeom, size, pos=(0, 0, 0), **kw):
@@ -269,6 +266,16 @@ def _shell(body: mujoco.MjsBody, name: str, kind, size, pos, rgba=SCOOTER_RGBA, 
     return g
 
 
+def _shell_capsule(body: mujoco.MjsBody, name: str, a, b, radius: float, rgba=DARK_RGBA) -> None:
+    g = body.add_geom(name=SCOOTER_COLLISION_PREFIX + name, type=G.mjGEOM_CAPSULE)
+    g.fromto = [*a, *b]
+    g.size = [radius, 0, 0]
+    g.rgba = list(rgba)
+    g.group = GROUP_ROBOT
+    g.contype, g.conaffinity = SCOOTER_TYPE, SCOOTER_AFFINITY
+    g.mass = 0.0
+
+
 def _add_scooter_shell(body: mujoco.MjsBody) -> None:
     """Deck, seat, tiller, handlebars, wheels, sensor posts and the basket, in `base`."""
     x0 = -dims.SCOOTER_REAR_OVERHANG
@@ -302,25 +309,15 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
     # Tiller, leaning back toward the rider, and the handlebars across its top.
     tiller_bottom = np.array([dims.TILLER_X + 0.04, 0.0, dims.SCOOTER_DECK_HEIGHT])
     tiller_top = np.array([dims.TILLER_X, 0.0, dims.HANDLEBAR_HEIGHT])
-    tiller = body.add_geom(name=SCOOTER_COLLISION_PREFIX + "tiller", type=G.mjGEOM_CAPSULE)
-    tiller.fromto = [*tiller_bottom, *tiller_top]
-    tiller.size = [0.04, 0, 0]
-    tiller.rgba = list(SCOOTER_RGBA)
-    tiller.group = GROUP_ROBOT
-    tiller.contype, tiller.conaffinity = SCOOTER_TYPE, SCOOTER_AFFINITY
-    tiller.mass = 0.0
-    bar = body.add_geom(name=SCOOTER_COLLISION_PREFIX + "handlebar", type=G.mjGEOM_CAPSULE)
-    half = dims.HANDLEBAR_WIDTH / 2
-    bar.fromto = [dims.TILLER_X - 0.03, half, dims.HANDLEBAR_HEIGHT] + [
-        dims.TILLER_X - 0.03,
-        -half,
-        dims.HANDLEBAR_HEIGHT,
-    ]
-    bar.size = [0.018, 0, 0]
-    bar.rgba = list(DARK_RGBA)
-    bar.group = GROUP_ROBOT
-    bar.contype, bar.conaffinity = SCOOTER_TYPE, SCOOTER_AFFINITY
-    bar.mass = 0.0
+    _shell_capsule(body, "tiller", tiller_bottom, tiller_top, 0.04, SCOOTER_RGBA)
+    half, bar_x = dims.HANDLEBAR_WIDTH / 2, dims.TILLER_X - 0.03
+    _shell_capsule(
+        body,
+        "handlebar",
+        (bar_x, half, dims.HANDLEBAR_HEIGHT),
+        (bar_x, -half, dims.HANDLEBAR_HEIGHT),
+        0.018,
+    )
     # Wheels: rear drive wheels on the axle (x = 0) and a front caster. Visual and collision
     # only: the base's planar joints, not wheel contacts, carry the scooter.
     wheel_q = _quat(rotx(math.pi / 2))
@@ -345,28 +342,26 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
     # Sensor posts: two uprights carrying the four low sensors, the left one taller for the
     # fifth sensor.
     for mount in dims.CAMERA_MOUNTS:
-        x, y, z = mount.pos
+        R = rotz(mount.yaw) @ roty(mount.pitch_down)
+        # The housing sits just behind the lens, so the camera never sees its own box.
+        centre = np.array(mount.pos) - R[:, 0] * 0.02
         _shell(
             body,
             f"sensor_{mount.name}",
             G.mjGEOM_BOX,
             (0.015, 0.06, 0.015),
-            (x, y, z),
+            centre,
             DARK_RGBA,
-            quat=_quat(rotz(mount.yaw) @ roty(mount.pitch_down)),
+            quat=_quat(R),
         )
     for side, y, top in (
         ("left", dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_HIGH_HEIGHT),
         ("right", -dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_LOW_HEIGHT),
     ):
-        post = body.add_geom(name=SCOOTER_COLLISION_PREFIX + f"post_{side}", type=G.mjGEOM_CAPSULE)
         x = dims.SENSOR_X - 0.1 if side == "left" else dims.SENSOR_X - 0.03
-        post.fromto = [x, y, dims.SCOOTER_DECK_HEIGHT, x, y, top - 0.02]
-        post.size = [0.015, 0, 0]
-        post.rgba = list(DARK_RGBA)
-        post.group = GROUP_ROBOT
-        post.contype, post.conaffinity = SCOOTER_TYPE, SCOOTER_AFFINITY
-        post.mass = 0.0
+        _shell_capsule(
+            body, f"post_{side}", (x, y, dims.SCOOTER_DECK_HEIGHT), (x, y, top - 0.02), 0.015
+        )
     # Projector housing above the tiller.
     px, py, pz = dims.PROJECTOR_POS
     _shell(body, "projector", G.mjGEOM_BOX, (0.06, 0.09, 0.035), (px, py, pz + 0.03), DARK_RGBA)
@@ -374,7 +369,14 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
     c, inner, w = dims.BASKET_CENTER, dims.BASKET_INNER, dims.BASKET_WALL
     hx, hy, hz = inner / 2
     basket_rgba = (0.15, 0.15, 0.16, 1.0)
-    _shell(body, "basket_floor", G.mjGEOM_BOX, (hx + w, hy + w, w / 2), c + [0, 0, -hz], basket_rgba)
+    _shell(
+        body,
+        "basket_floor",
+        G.mjGEOM_BOX,
+        (hx + w, hy + w, w / 2),
+        c + np.array([0.0, 0.0, -hz]),
+        basket_rgba,
+    )
     for name, pos, size in (
         ("basket_front", (hx + w / 2, 0, 0), (w / 2, hy + w, hz)),
         ("basket_back", (-hx - w / 2, 0, 0), (w / 2, hy + w, hz)),
@@ -534,7 +536,9 @@ def build_sim_spec(scene: Scene | None) -> mujoco.MjSpec:
     floor.group = GROUP_OPAQUE
     floor.contype, floor.conaffinity = STATIC_TYPE, STATIC_AFFINITY
     floor.friction = [0.9, 0.005, 0.0001]
-    world.add_light(name="sun", pos=[0, 0, 4], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+    world.add_light(
+        name="sun", pos=[0, 0, 4], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+    )
     if scene is not None:
         add_scene_to_spec(spec, scene)
     scooter = world.add_body(name=SCOOTER_BODY, pos=[0, 0, 0])

@@ -107,7 +107,9 @@ class Simulation:
         self.info = ModelInfo.of(self.model)
         self.arm_model = build_arm_model()
         self.dt = float(self.model.opt.timestep)
-        self._control_every = max(1, round(self.settings.sim.rate_hz / self.settings.sim.control_rate_hz))
+        self._control_every = max(
+            1, round(self.settings.sim.rate_hz / self.settings.sim.control_rate_hz)
+        )
         self._lock = threading.RLock()
         self._inbox: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
         self._thread: threading.Thread | None = None
@@ -316,7 +318,7 @@ class Simulation:
         """Headless: step for `seconds` of sim time."""
         self.step(max(1, round(seconds / self.dt)))
 
-    # --- the loop ----------------------------------------------------------------------------------
+    # --- the loop ------------------------------------------------------------------------
 
     def _post(self, fn: Callable[[], None]) -> None:
         if self._thread is None:
@@ -388,7 +390,9 @@ class Simulation:
                     if pos_err < self._cart_tol[0] and rot_err < self._cart_tol[1]:
                         self._end_motion("done")
                     elif d.time > self._cart_deadline:
-                        self._end_motion("failed", f"TCP target not reached ({pos_err * 1000:.1f} mm off)")
+                        self._end_motion(
+                            "failed", f"TCP target not reached ({pos_err * 1000:.1f} mm off)"
+                        )
             except Exception as exc:
                 log.exception("arm control failed")
                 self._halt("failed", f"arm control failed: {exc}")
@@ -408,7 +412,9 @@ class Simulation:
         yaw = d.qpos[info.base_qpos[2]]
         d.ctrl[info.base_ctrl] = [v * math.cos(yaw), v * math.sin(yaw), w]
 
-    def _replace_motion(self, motion: TrajectoryTracker | CartesianController, handle: MotionHandle) -> None:
+    def _replace_motion(
+        self, motion: TrajectoryTracker | CartesianController, handle: MotionHandle
+    ) -> None:
         if self._handle is not None:
             self._handle._finish("stopped", "replaced by a new motion")
         self._motion, self._handle = motion, handle

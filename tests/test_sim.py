@@ -1,0 +1,172 @@
+"""The simulation loop: real-time pacing, pause, headless determinism, e-stop, the drive's
+dead-man and acceleration limits, trajectory tracking, and that bad commands hurt nothing."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+from laserpick.pipeline.trajectory import GripperEvent, Trajectory
+from laserpick.robot import dims
+from laserpick.robot import kinematics as K
+from laserpick.robot.scenes import load_scene
+from laserpick.robot.sim import Simulation
+
+
+@pytest.fixture
+def sim():
+    s = Simulation(load_scene("isolation"), realtime=False)
+    yield s
+    s.close()
+
+
+def _line(q0: np.ndarray, q1: np.ndarray, speed: float = 0.5) -> Trajectory:
+    dur = max(0.2, float(np.max(np.abs(q1 - q0))) / speed)
+    t = np.linspace(0.0, dur, 50)
+    s = 0.5 - 0.5 * np.cos(np.pi * t / dur)  # smooth start and stop
+    return Trajectory(times=t, q=q0 + s[:, None] * (q1 - q0))
+
+
+def test_contact_options_hold_a_parallel_jaw_grasp(sim):
+    import mujoco
+
+    opt = sim.model.opt
+    assert opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+    assert opt.impratio >= 10
+    pads = sim.info.pad_geoms
+    assert np.all(sim.model.geom_condim[pads] == 4)
+
+
+def test_trajectory_is_tracked_and_its_gripper_events_fire(sim):
+    q0 = sim.snapshot().arm_q
+    q1 = q0 + np.array([0.4, 0.3, -0.3, 0.2, 0.2, 0.5])
+    traj = _line(q0, q1)
+    traj = Trajectory(traj.times, traj.q, (GripperEvent(traj.duration / 2, "close"),))
+    h = sim.execute(traj)
+    assert sim.run_until(h, traj.duration + 2.0) == "done"
+    sim.settle(0.5)
+    s = sim.snapshot()
+    assert np.max(np.abs(s.arm_q - q1)) < 2e-3
+    assert s.gripper_closed and s.gripper_width < 0.002  # closed on nothing
+    assert not s.holding
+
+
+def test_estop_halts_within_one_step_and_latches(sim):
+    q0 = sim.snapshot().arm_q
+    h = sim.execute(_line(q0, q0 + np.array([1.5, 0.0, 0.0, 0.0, 0.0, 1.5]), speed=1.0))
+    sim.step(300)  # mid-motion
+    assert np.max(np.abs(sim.snapshot().arm_qd)) > 0.3
+    t_stop = sim.snapshot().time
+    sim.stop()
+    assert h.status == "stopped"
+    sim.step(10)  # 20 ms of sim time
+    s = sim.snapshot()
+    assert s.time - t_stop <= 0.02 + 1e-9
+    assert np.max(np.abs(s.arm_qd)) < 1e-3, f"arm still moving after e-stop: {s.arm_qd}"
+    assert s.estopped
+    # Latched: new motion is refused, the arm stays put.
+    h2 = sim.execute(_line(s.arm_q, s.arm_q + 0.3))
+    assert h2.status == "failed" and "e-stop" in h2.message
+    sim.drive(0.5, 0.0)
+    sim.step(100)
+    assert np.linalg.norm(sim.snapshot().base_velocity) < 1e-6
+    sim.reset_stop()
+    h3 = sim.execute(_line(sim.snapshot().arm_q, sim.snapshot().arm_q + 0.1))
+    assert sim.run_until(h3, 3.0) == "done"
+
+
+def test_drive_is_a_dead_man_with_acceleration_limits(sim):
+    x0 = sim.snapshot().base_pose.copy()
+    sim.drive(0.6, 0.0, duration=10.0)  # asks for 10 s; capped at 0.5 s
+    sim.step(round(0.1 / sim.dt))
+    v = sim.snapshot().base_velocity[0]
+    assert v <= dims.BASE_A_MAX * 0.1 + 0.02, "acceleration limit not respected"
+    sim.settle(2.0)
+    s = sim.snapshot()
+    assert abs(s.base_velocity[0]) < 1e-2, "the base kept moving without a fresh command"
+    moved = s.base_pose[0] - x0[0]
+    assert 0.05 < moved < 0.6 * 0.5 + 0.05
+
+
+def test_drive_turns_with_the_heading(sim):
+    for _ in range(20):
+        sim.drive(0.0, 0.8)
+        sim.settle(0.1)
+    sim.settle(1.5)
+    yaw = sim.snapshot().base_pose[2]
+    assert yaw > 0.5
+    x0 = sim.snapshot().base_pose[:2].copy()
+    for _ in range(10):
+        sim.drive(0.4, 0.0)
+        sim.settle(0.1)
+    sim.settle(1.0)
+    d = sim.snapshot().base_pose[:2] - x0
+    heading = math.atan2(d[1], d[0])
+    assert abs(heading - yaw) < 0.05
+
+
+def test_bad_commands_are_refused_and_the_loop_survives(sim):
+    with pytest.raises(ValueError):
+        sim.drive(float("nan"), 0.0)
+    with pytest.raises(ValueError):
+        Trajectory(times=np.array([0.0, 1.0]), q=np.full((2, 6), np.inf))
+    bad = np.eye(4)
+    bad[0, 3] = np.nan
+    h = sim.move_tcp(bad)
+    assert h.status == "failed"
+    q = sim.snapshot().arm_q
+    far = _line(q + 1.0, q + 1.2)  # does not start where the arm is
+    assert sim.execute(far).status == "failed"
+    sim.step(50)
+    assert np.max(np.abs(sim.snapshot().arm_q - q)) < 1e-3
+
+
+def test_cartesian_move_reaches_a_pose_in_front(sim):
+    T = K.tcp_pose(sim.snapshot().arm_q)
+    T[:3, 3] += [0.2, 0.1, 0.1]
+    h = sim.move_tcp(T)
+    assert sim.run_until(h, 10.0) == "done", h.message
+    s = sim.snapshot()
+    assert np.linalg.norm(K.tcp_pose(s.arm_q)[:3, 3] - T[:3, 3]) < 3e-3
+
+
+def test_headless_mode_is_deterministic():
+    def run() -> np.ndarray:
+        s = Simulation(load_scene("isolation"), realtime=False)
+        q0 = s.snapshot().arm_q
+        s.run_until(s.execute(_line(q0, q0 + 0.3)), 3.0)
+        s.drive(0.3, 0.2)
+        s.settle(0.5)
+        return s.snapshot().qpos
+
+    np.testing.assert_array_equal(run(), run())
+
+
+def test_realtime_loop_keeps_pace_and_pauses():
+    s = Simulation(load_scene("isolation"), realtime=True)
+    s.start()
+    try:
+        time.sleep(0.3)
+        t0, w0 = s.snapshot().time, time.perf_counter()
+        time.sleep(1.5)
+        t1, w1 = s.snapshot().time, time.perf_counter()
+        rate = (t1 - t0) / (w1 - w0)
+        # Loose bounds: this checks pacing (not free-running), not the machine's speed.
+        assert 0.5 < rate < 1.5, f"sim advanced {rate:.2f} s per wall second"
+        s.pause()
+        time.sleep(0.1)
+        tp = s.snapshot().time
+        time.sleep(0.3)
+        assert s.snapshot().time == tp
+        s.resume()
+        time.sleep(0.2)
+        assert s.snapshot().time > tp
+        # A command from another thread is applied by the loop.
+        s.stop()
+        time.sleep(0.1)
+        assert s.snapshot().estopped
+    finally:
+        s.close()
