@@ -125,7 +125,7 @@ class CameraMount:
     yaw: float  #: rotation about +z; positive turns left
 
 
-SENSOR_X = 0.92  #: the sensor posts stand just behind the basket (m)
+SENSOR_X = 1.08  #: the sensor posts stand beside the basket, cameras just ahead of it (m)
 SENSOR_LOW_HEIGHT = 1.14
 SENSOR_HIGH_HEIGHT = 1.56
 SENSOR_GROUP_SPACING = 0.63
@@ -155,9 +155,11 @@ DEPTH_MAX = 3.5  #: m, farthest valid depth
 
 # --- Projector and laser ------------------------------------------------------------------
 
-#: The projector sits above the tiller, looking forward and down at the workspace.
-PROJECTOR_POS = (0.80, 0.0, 1.45)
-PROJECTOR_PITCH_DOWN = math.radians(40.0)
+#: The projector hangs on a bracket from the tall left sensor post, aimed forward, down and
+#: to the right at the middle of the workspace in front of the arm.
+PROJECTOR_POS = (0.98, 0.20, 1.38)
+PROJECTOR_PITCH_DOWN = math.radians(45.0)
+PROJECTOR_YAW = math.radians(-25.0)
 PROJECTOR_WIDTH = 1280  #: pixels (EPSON H801A-like WXGA panel)
 PROJECTOR_HEIGHT = 800
 PROJECTOR_FOVY = math.radians(32.0)

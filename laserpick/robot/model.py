@@ -358,13 +358,29 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
         ("left", dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_HIGH_HEIGHT),
         ("right", -dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_LOW_HEIGHT),
     ):
-        x = dims.SENSOR_X - 0.1 if side == "left" else dims.SENSOR_X - 0.03
+        x = dims.SENSOR_X - 0.1
         _shell_capsule(
             body, f"post_{side}", (x, y, dims.SCOOTER_DECK_HEIGHT), (x, y, top - 0.02), 0.015
         )
-    # Projector housing above the tiller.
+    # Projector housing on its bracket from the tall left post.
     px, py, pz = dims.PROJECTOR_POS
-    _shell(body, "projector", G.mjGEOM_BOX, (0.06, 0.09, 0.035), (px, py, pz + 0.03), DARK_RGBA)
+    _shell(
+        body,
+        "projector",
+        G.mjGEOM_BOX,
+        (0.06, 0.09, 0.035),
+        (px, py, pz + 0.03),
+        DARK_RGBA,
+        quat=_quat(rotz(dims.PROJECTOR_YAW)),
+    )
+    post_x = dims.SENSOR_X - 0.1
+    _shell_capsule(
+        body,
+        "projector_bracket",
+        (post_x, dims.SENSOR_GROUP_SPACING / 2, pz + 0.03),
+        (px, py, pz + 0.03),
+        0.012,
+    )
     # Basket: a floor and four walls, open at the top.
     c, inner, w = dims.BASKET_CENTER, dims.BASKET_INNER, dims.BASKET_WALL
     hx, hy, hz = inner / 2
@@ -416,7 +432,7 @@ def _add_sensors(body: mujoco.MjsBody) -> None:
     proj = body.add_camera(
         name=PROJECTOR_CAMERA,
         pos=list(dims.PROJECTOR_POS),
-        quat=_quat(camera_rotation(dims.PROJECTOR_PITCH_DOWN, 0.0)),
+        quat=_quat(camera_rotation(dims.PROJECTOR_PITCH_DOWN, dims.PROJECTOR_YAW)),
     )
     proj.fovy = math.degrees(dims.PROJECTOR_FOVY)
     body.add_site(name=LASER_SITE, pos=list(dims.LASER_ORIGIN), size=[0.01, 0, 0], group=5)
