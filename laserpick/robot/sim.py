@@ -340,9 +340,9 @@ class Simulation:
             with self._lock:
                 for _ in range(_CHUNK_STEPS):
                     self._step_once()
-            self._publish()
+                self._publish()
             now = time.perf_counter()
-            if now - rtf_wall >= 1.0:
+            if now - rtf_wall >= 0.5:
                 self._rtf = (self.data.time - rtf_sim) / (now - rtf_wall)
                 rtf_wall, rtf_sim = now, self.data.time
             lag = (wall0 + (self.data.time - sim0)) - now
