@@ -21,5 +21,5 @@ test-slow: bootstrap
 lint: bootstrap
 	$(VENV)/ruff check . && $(VENV)/ruff format --check .
 
-bench-rtf: bootstrap
+bench-rtf: bootstrap  ## real-time factor with the console and cameras (30 s)
 	$(VENV)/python bench/realtime_factor.py

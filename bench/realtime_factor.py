@@ -176,7 +176,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"scene            {args.scene}  (browser {width}x{height}, {clients} client)")
     print(f"sim seconds      {sim_s:8.2f}")
     print(f"wall seconds     {wall_s:8.2f}")
-    print(f"RTF              {rtf:8.4f}   (sim's own last 1 s window: {snap1.rtf:.3f})")
+    print(f"RTF              {rtf:8.4f}   (sim's own last 0.5 s window: {snap1.rtf:.3f})")
     print(
         f"capture rate     {n_cap / wall_s:8.2f} rounds/s of 5 frames "
         f"(target {args.capture_hz:g}; mean round {mean_cap * 1000:.0f} ms)"

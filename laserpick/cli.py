@@ -83,7 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="isolation",
         help="a built-in scene name (isolation, kitchen, surfaces, jeeves) or a YAML path",
     )
-    serve.add_argument("--viewer-rate", type=float, default=30.0, help="3D view updates (Hz)")
+    serve.add_argument("--viewer-rate", type=float, default=40.0, help="3D view updates (Hz)")
     serve.add_argument(
         "--no-shadows",
         dest="shadows",

@@ -208,7 +208,7 @@ class SceneViewer:
         sim: Simulation,
         server: viser.ViserServer,
         *,
-        rate_hz: float = 30.0,
+        rate_hz: float = 40.0,
         set_initial_camera: bool = True,
         controls: bool = True,
         shadows: bool = True,
