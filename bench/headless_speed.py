@@ -1,6 +1,6 @@
 """How much faster than real time the headless (benchmark) mode steps a scene.
 
-    MUJOCO_GL=egl .venv/bin/python bench/headless_speed.py [--scene isolation] [--seconds 20]
+MUJOCO_GL=egl .venv/bin/python bench/headless_speed.py [--scene isolation] [--seconds 20]
 """
 
 from __future__ import annotations
