@@ -36,23 +36,12 @@ except ImportError:  # run as a script from a checkout without `pip install -e .
 
 import viser
 
+from laserpick.console import headless_chromium
 from laserpick.console.viewer import SceneViewer
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sensors import DepthCameras
 from laserpick.robot.sim import Simulation
 from laserpick.settings import get_settings
-
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-]
 
 
 @dataclass
@@ -137,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         sim.start()
         viewer.start()
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+            browser = headless_chromium.launch(p)
             try:
                 page = browser.new_page(viewport={"width": width, "height": height})
                 page.goto(url)

@@ -23,20 +23,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from laserpick.console import headless_chromium
+
 REPO = Path(__file__).resolve().parents[1]
 ARTIFACTS = REPO / "test-artifacts"
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-    # WebGL without a GPU: ANGLE on SwiftShader (software Vulkan).
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-]
 
 
 def _free_port() -> int:
@@ -131,7 +121,7 @@ class _Server:
 
 def test_serve_renders_in_chromium_and_stops_cleanly() -> None:
     playwright = pytest.importorskip("playwright.sync_api")
-    if not Path(CHROMIUM).exists():
+    if not Path(headless_chromium.CHROMIUM).exists():
         pytest.skip("no Chromium at /usr/bin/chromium")
     viser_port, api_port = _free_port(), _free_port()
     server = _Server(
@@ -149,7 +139,7 @@ def test_serve_renders_in_chromium_and_stops_cleanly() -> None:
         ARTIFACTS.mkdir(exist_ok=True)
         shot_path = ARTIFACTS / "console.png"
         with playwright.sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+            browser = headless_chromium.launch(p)
             try:
                 # Software WebGL renders a frame in about a second: keep the view small.
                 page = browser.new_page(viewport={"width": 800, "height": 500})

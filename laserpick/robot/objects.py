@@ -19,6 +19,7 @@ depth sensors do not see them) and specular objects in `GROUP_SPECULAR`.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections.abc import Sequence
@@ -27,6 +28,8 @@ from typing import Literal
 
 import mujoco
 import numpy as np
+
+from laserpick.transforms import matrix_from_quat
 
 OpticalKind = Literal["opaque", "transparent", "specular"]
 PartKind = Literal["box", "cylinder", "sphere", "capsule", "ellipsoid", "mesh"]
@@ -181,13 +184,6 @@ class ObjectModel:
 # --- geometry helpers ---------------------------------------------------------------------
 
 
-def quat_to_mat(q: Sequence[float]) -> np.ndarray:
-    """Rotation matrix (3, 3) of a unit quaternion given as wxyz."""
-    m = np.zeros(9)
-    mujoco.mju_quat2Mat(m, np.asarray(q, dtype=float))
-    return m.reshape(3, 3)
-
-
 def quat_mul(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
     """Hamilton product a*b of two wxyz quaternions (apply b first, then a)."""
     out = np.zeros(4)
@@ -228,7 +224,7 @@ def part_volume(part: Part, model: ObjectModel | None = None) -> float:
 def part_support(part: Part, d: np.ndarray, model: ObjectModel | None = None) -> float:
     """Support function of a part: max over its points p of p . d (m), in the object frame."""
     pos = np.asarray(part.pos, dtype=float)
-    rot = quat_to_mat(part.quat)
+    rot = matrix_from_quat(part.quat)
     if part.kind == "mesh":
         if model is None:
             raise ValueError("a mesh part's support needs its model")
@@ -257,7 +253,7 @@ def support(model: ObjectModel, d: Sequence[float], quat: Sequence[float] | None
     """
     d = np.asarray(d, dtype=float)
     if quat is not None:
-        d = quat_to_mat(quat).T @ d
+        d = matrix_from_quat(quat).T @ d
     return max(part_support(p, d, model) for p in model.parts)
 
 
@@ -268,7 +264,7 @@ def center_of_mass(model: ObjectModel) -> np.ndarray:
     for p in model.parts:
         if p.kind == "mesh":
             v = model.mesh_asset(p.mesh or "").vertices
-            c = quat_to_mat(p.quat) @ v.mean(axis=0) + np.asarray(p.pos)
+            c = matrix_from_quat(p.quat) @ v.mean(axis=0) + np.asarray(p.pos)
         else:
             c = np.asarray(p.pos, dtype=float)
         centres.append(c)
@@ -334,7 +330,7 @@ def _rest_pose_cached(model: ObjectModel, lying: bool) -> RestPose:
         com = center_of_mass(model)
         best: tuple[float, int] | None = None
         for i, cand in enumerate(_LYING_CANDIDATES):
-            h = float((quat_to_mat(cand) @ com)[2]) + support(model, (0, 0, -1), cand)
+            h = float((matrix_from_quat(cand) @ com)[2]) + support(model, (0, 0, -1), cand)
             if best is None or h < best[0] - 1e-4:
                 best = (h, i)
         q = _LYING_CANDIDATES[best[1] if best else 0].copy()
@@ -466,16 +462,7 @@ def _obj(
     bottom = -support(probe, (0, 0, -1))
     if abs(bottom) > 1e-6:
         raise ValueError(f"library object {name!r} does not start at z = 0 (bottom {bottom})")
-    return ObjectModel(
-        name=name,
-        category=category,
-        parts=parts,
-        mass=mass,
-        friction=friction,
-        rgba=rgba,
-        optical=optical,
-        height=support(probe, (0, 0, 1)),
-    )
+    return dataclasses.replace(probe, height=support(probe, (0, 0, 1)))
 
 
 def _bowl() -> list[Part]:
