@@ -61,6 +61,89 @@ class SensorSettings(BaseModel):
     seed: int = Field(0, description="Seed of the sensor noise generator.")
 
 
+class PerceptionSettings(BaseModel):
+    """Fusion, laser detection, segmentation and surface parameters (papers 004, 000, 002)."""
+
+    pixel_stride: int = Field(
+        2, ge=1, le=8, description="Use every n-th pixel of each depth image when fusing."
+    )
+    workspace_min: tuple[float, float, float] = Field(
+        (0.3, -1.2, -0.05), description="Workspace crop box, lower corner in `base` (m)."
+    )
+    workspace_max: tuple[float, float, float] = Field(
+        (2.6, 1.2, 1.9), description="Workspace crop box, upper corner in `base` (m)."
+    )
+    voxel_size: float = Field(
+        0.0, ge=0, description="Voxel downsampling edge (m); 0 keeps every point."
+    )
+    laser_threshold: int = Field(
+        250, ge=1, le=255, description="IR intensity of a laser dot (0-255)."
+    )
+    laser_pair_px: float = Field(
+        40.0, gt=0, description="Largest image distance (px) between the two beams' spots."
+    )
+    laser_match_m: float = Field(
+        0.02, gt=0, description="Views agree on a mark when their 3D points lie this close (m)."
+    )
+    plane_distance: float = Field(
+        0.015, gt=0, description="RANSAC plane distance threshold (m). 004 section 6.1."
+    )
+    plane_max_tilt_deg: float = Field(
+        5.0, ge=0, description="Largest angle of a removed plane from horizontal. 004 6.1."
+    )
+    plane_min_inliers: int = Field(
+        13000, ge=1, description="Inliers a plane needs to be removed, at 004's density. 004 6.1."
+    )
+    plane_max_removed: float = Field(
+        0.70, gt=0, le=1, description="Largest fraction of the cloud removed as planes. 004 6.1."
+    )
+    cluster_tolerance: float = Field(
+        0.005, gt=0, description="Euclidean cluster extraction distance (m). 004 section 6.1."
+    )
+    cluster_min_points: int = Field(
+        500, ge=1, description="A smaller target cluster falls back to the ball. 004 6.1."
+    )
+    fallback_ball_radius: float = Field(
+        0.1, gt=0, description="Radius of the fallback ball around the mark (m). 004 6.1."
+    )
+    merged_fraction: float = Field(
+        0.9,
+        gt=0,
+        le=1,
+        description=(
+            "A segment holding more of the points near the mark than this has merged with its"
+            " support. 002 II.C."
+        ),
+    )
+    merged_radius: float = Field(
+        0.08, gt=0, description="Radius taken around the mark when the segment merged (m). 002."
+    )
+    grid_cell_xy: float = Field(
+        0.01, gt=0, description="EL-E occupancy grid cell, x and y (m). 000 section 4.2.2."
+    )
+    grid_cell_z: float = Field(
+        0.0025, gt=0, description="EL-E occupancy grid cell, z (m). 000 section 4.2.2."
+    )
+    histogram_bin: float = Field(
+        0.0025, gt=0, description="Surface height histogram bin (m). 000 section 4.2.1."
+    )
+    histogram_cut: float = Field(
+        0.2, gt=0, le=1, description="Bins above n_max times this are surface. 000 4.2.1."
+    )
+    flat_fraction: float = Field(
+        0.25,
+        gt=0,
+        le=1,
+        description=(
+            "Occupied share of the volume of interest's cross-section that makes a flat"
+            " surface. 000 4.4.3."
+        ),
+    )
+    place_edge_margin: float = Field(
+        0.10, ge=0, description="A place mark moves at least this far behind the edge (m). 000 4.5."
+    )
+
+
 class Settings(BaseSettings):
     """All of laserpick's tunable defaults."""
 
@@ -68,6 +151,7 @@ class Settings(BaseSettings):
 
     sim: SimSettings = SimSettings()
     sensor: SensorSettings = SensorSettings()
+    perception: PerceptionSettings = PerceptionSettings()
 
 
 @lru_cache(maxsize=1)
