@@ -144,6 +144,39 @@ class PerceptionSettings(BaseModel):
     )
 
 
+class GraspSettings(BaseModel):
+    """Grasp selection parameters (paper 004 section 7) and the hand geometry the pipeline uses.
+
+    The hand geometry mirrors the gripper in `laserpick.robot.dims` (a test holds them equal);
+    it is repeated here because pipeline/ may not import robot/.
+    """
+
+    width_min: float = Field(0.0, ge=0, description="Gripper's smallest opening W_min (m).")
+    width_max: float = Field(0.085, gt=0, description="Gripper's stroke W_max (m). 2F-85.")
+    finger_length: float = Field(
+        0.05, gt=0, description="Finger length l, the reach of Cs (m). Eq. 6 of 004."
+    )
+    width_margin: float = Field(
+        0.015, ge=0, description="W_d, the distance kept from the stroke's ends (m). 004 eq. 3."
+    )
+    joint_distance_max: float = Field(
+        7.695,
+        gt=0,
+        description=(
+            "J_m of 004 eq. 4 (rad): pi * sqrt(6), the largest joint-space distance between two"
+            " configurations once each joint's difference is wrapped to [-pi, pi]."
+        ),
+    )
+    mark_distance: float = Field(
+        0.05, ge=0, description="th, the mark distance free of penalty (m). 004 eq. 7."
+    )
+    cluster_distance: float = Field(
+        0.02,
+        gt=0,
+        description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
+    )
+
+
 class Settings(BaseSettings):
     """All of laserpick's tunable defaults."""
 
@@ -152,6 +185,7 @@ class Settings(BaseSettings):
     sim: SimSettings = SimSettings()
     sensor: SensorSettings = SensorSettings()
     perception: PerceptionSettings = PerceptionSettings()
+    grasp: GraspSettings = GraspSettings()
 
 
 @lru_cache(maxsize=1)

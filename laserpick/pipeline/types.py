@@ -129,3 +129,64 @@ class Segmentation:
     indices: np.ndarray
     method: SegmentMethod
     surface: SupportSurface | None
+
+
+@dataclass(frozen=True)
+class GraspScores:
+    """The five factors of paper 004's grasp objective, eq. 2: C = Cw * Cj * Ca * Cs * Cp.
+
+    Cw: width away from the stroke's ends (eq. 3); Cj: short joint-space reach (eq. 4);
+    Ca: top grasps, then side grasps from the front (eq. 5); Cs: near the segmented cloud
+    (eq. 6); Cp: near the laser mark (eq. 7). Each lies in [0, 1].
+    """
+
+    Cw: float
+    Cj: float
+    Ca: float
+    Cs: float
+    Cp: float
+
+    @property
+    def total(self) -> float:
+        return self.Cw * self.Cj * self.Ca * self.Cs * self.Cp
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """A 6-DOF grasp of the parallel gripper.
+
+    pose: (4, 4) TCP pose in `base`. Its columns are the hand axis (x), the closing axis (y,
+    between the fingers) and the approach axis (z, from the palm toward the object), as in
+    GPD; the TCP is midway between the fingertips.
+    width: the object's extent between the fingers (m).
+    scores: the selection factors, once scored.
+    cluster: index of the position cluster for manual selection (-1 before clustering).
+    ik: the chosen joint solution (6,), or None with `ik_failure` saying why.
+    """
+
+    pose: np.ndarray
+    width: float
+    scores: GraspScores | None = None
+    cluster: int = -1
+    ik: np.ndarray | None = None
+    ik_failure: str | None = None
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.pose[:3, 3]
+
+    @property
+    def approach(self) -> np.ndarray:
+        return self.pose[:3, 2]
+
+    @property
+    def closing(self) -> np.ndarray:
+        return self.pose[:3, 1]
+
+    @property
+    def axis(self) -> np.ndarray:
+        return self.pose[:3, 0]
+
+    @property
+    def score(self) -> float:
+        return self.scores.total if self.scores is not None else 0.0

@@ -1,0 +1,141 @@
+"""Grasp selection against hand-worked values of paper 004's eqs. 3-7, the 0.02 m cluster
+bound, and stepping through clusters."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from laserpick.pipeline import selection as sel
+from laserpick.pipeline.types import Grasp
+from laserpick.robot import dims
+from laserpick.settings import GraspSettings
+
+S = GraspSettings()
+
+
+def _pose(approach, closing, p=(1.5, 0.0, 0.5)) -> np.ndarray:
+    a, c = np.asarray(approach, float), np.asarray(closing, float)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([np.cross(c, a), c, a])
+    T[:3, 3] = p
+    return T
+
+
+def test_hand_geometry_settings_match_the_gripper():
+    assert pytest.approx(dims.GRIPPER_STROKE) == S.width_max
+    assert pytest.approx(dims.GRIPPER_FINGER_LENGTH) == S.finger_length
+    assert S.joint_distance_max == pytest.approx(math.pi * math.sqrt(6), abs=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("width", "expected"),
+    [
+        (0.040, 1.0),  # mid-stroke: 0.040 from 0 and 0.045 from 0.085, both beyond W_d
+        (0.015, 1.0),  # exactly W_d from W_min
+        (0.010, 1 - (0.015 - 0.010) / 0.015),  # 1/3 inside the margin: 2/3
+        (0.080, 1 - (0.015 - 0.005) / 0.015),  # 5 mm from W_max: 1/3
+        (0.085, 0.0),  # at the stroke's end
+        (0.0, 0.0),
+    ],
+)
+def test_width_factor_eq3(width, expected):
+    assert sel.width_factor(width, S) == pytest.approx(expected)
+
+
+def test_joint_factor_eq4():
+    q = np.zeros(6)
+    g = np.array([0.3, 0.4, 0.0, 0.0, 0.0, 0.0])  # distance 0.5 rad
+    assert sel.joint_factor(q, g, S) == pytest.approx(1 - 0.5 / S.joint_distance_max)
+    assert sel.joint_factor(q, q, S) == 1.0
+    assert sel.joint_factor(q, np.full(6, 10.0), S) == 0.0  # clipped at 0
+
+
+def test_approach_factor_eq5_in_an_x_forward_frame():
+    down = np.array([0.0, 0.0, -1.0])
+    assert sel.approach_factor(down, np.array([1.0, 0.0, 0.0])) == 1.0  # top grasp
+    vertical_axis = np.array([0.0, 0.0, 1.0])
+    # Side grasp straight from the front (along +x in `base`): 0.5 + 0.5 * 1.
+    assert sel.approach_factor(np.array([1.0, 0.0, 0.0]), vertical_axis) == 1.0
+    # Side grasp from the left (along -y): the paper's y-forward would call it frontal; ours
+    # does not: 0.5 + 0.5 * 0.
+    assert sel.approach_factor(np.array([0.0, -1.0, 0.0]), vertical_axis) == 0.5
+    diag = np.array([math.cos(math.radians(60)), math.sin(math.radians(60)), 0.0])
+    assert sel.approach_factor(diag, vertical_axis) == pytest.approx(0.75)
+
+
+def test_sample_factor_eq6():
+    tcp = np.array([1.0, 0.0, 0.5])
+    sample = np.array([[1.02, 0.0, 0.5], [1.2, 0.0, 0.5]])  # nearest 0.02 m away
+    assert sel.sample_factor(tcp, sample, S) == pytest.approx(1 - 0.02 / 0.05)
+    assert sel.sample_factor(tcp, sample + [1.0, 0, 0], S) == 0.0  # beyond l
+    assert sel.sample_factor(tcp, np.zeros((0, 3)), S) == 0.0
+
+
+def test_mark_factor_eq7():
+    tcp = np.array([1.0, 0.0, 0.5])
+    assert sel.mark_factor(tcp, tcp + [0.04, 0, 0], S) == 1.0  # inside th
+    assert sel.mark_factor(tcp, tcp + [0.15, 0, 0], S) == pytest.approx(math.exp(-1.0))
+
+
+def test_score_multiplies_the_factors_and_needs_ik():
+    g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0]), width=0.010, ik=np.full(6, 0.1))
+    scored = sel.score(g, q_now=np.zeros(6), sample=g.position[None, :], mark=g.position)
+    f = scored.scores
+    assert f is not None
+    assert f.Cw == pytest.approx(2 / 3)
+    assert f.Cs == 1.0 and f.Cp == 1.0 and f.Ca == 1.0
+    assert scored.score == pytest.approx(f.Cw * f.Cj * f.Ca * f.Cs * f.Cp)
+    with pytest.raises(ValueError, match="IK"):
+        sel.score(Grasp(pose=g.pose, width=0.01), q_now=np.zeros(6), sample=g.pose, mark=g.position)
+
+
+def test_clusters_never_span_more_than_2cm():
+    rng = np.random.default_rng(5)
+    pts = rng.uniform(0, 0.1, size=(300, 3))
+    labels = sel.cluster_positions(pts, 0.02)
+    for c in np.unique(labels):
+        members = pts[labels == c]
+        if len(members) > 1:
+            d = np.linalg.norm(members[:, None] - members[None], axis=-1)
+            assert d.max() <= 0.02 + 1e-12
+    # Two tight groups 10 cm apart give exactly two clusters.
+    a = np.array([[0, 0, 0], [0.005, 0, 0], [0, 0.01, 0]])
+    labels = sel.cluster_positions(np.vstack([a, a + [0.1, 0, 0]]), 0.02)
+    assert len(set(labels[:3])) == 1 and len(set(labels[3:])) == 1 and labels[0] != labels[3]
+
+
+def _scored(p, total_like: float) -> Grasp:
+    # A grasp whose only imperfect factor is Cj, so its score is easy to set.
+    g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p), width=0.04, ik=np.zeros(6))
+    q_now = np.array([(1 - total_like) * S.joint_distance_max, 0, 0, 0, 0, 0])
+    return sel.score(g, q_now=q_now, sample=np.array([p]), mark=np.array(p))
+
+
+def test_group_orders_clusters_and_candidates_by_score_and_the_cursor_steps():
+    grasps = [
+        _scored((1.5, 0.0, 0.5), 0.6),
+        _scored((1.5, 0.005, 0.5), 0.9),  # same cluster as the first, better
+        _scored((1.6, 0.0, 0.5), 0.7),  # its own cluster
+        _scored((1.7, 0.0, 0.5), 0.95),  # best overall
+    ]
+    groups = sel.group(grasps)
+    assert len(groups.clusters) == 3
+    assert groups.best is not None and groups.best.score == pytest.approx(0.95)
+    firsts = [groups.grasps[m[0]].score for m in groups.clusters]
+    assert firsts == sorted(firsts, reverse=True)
+    cur = sel.GraspCursor(groups)
+    assert cur.current.score == pytest.approx(0.95)
+    assert cur.next().score == pytest.approx(0.9)
+    assert cur.describe() == "cluster 2 of 3, candidate 1 of 2"
+    assert cur.next_candidate().score == pytest.approx(0.6)
+    assert cur.next_candidate().score == pytest.approx(0.9)  # wraps within the cluster
+    assert cur.prev().score == pytest.approx(0.95)
+    assert cur.prev().score == pytest.approx(0.7)  # wraps over clusters
+    assert all(g.cluster >= 0 for g in groups.grasps)
+    with pytest.raises(IndexError, match="cluster 3"):
+        cur.select(3)
+    with pytest.raises(ValueError):
+        sel.GraspCursor(sel.group([]))
