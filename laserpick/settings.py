@@ -92,7 +92,14 @@ class PerceptionSettings(BaseModel):
         5.0, ge=0, description="Largest angle of a removed plane from horizontal. 004 6.1."
     )
     plane_min_inliers: int = Field(
-        13000, ge=1, description="Inliers a plane needs to be removed, at 004's density. 004 6.1."
+        13000,
+        ge=1,
+        description=(
+            "Inliers a plane needs to be removed, at 004's density: five Structure sensors at"
+            " full 640x480 resolution. Ours are the same sensors (640x480, same mounts), fused"
+            " at every pixel_stride-th pixel, so segment.py needs 13000 / pixel_stride^2"
+            " (3250 at stride 2). 004 6.1."
+        ),
     )
     plane_max_removed: float = Field(
         0.70, gt=0, le=1, description="Largest fraction of the cloud removed as planes. 004 6.1."
@@ -142,6 +149,90 @@ class PerceptionSettings(BaseModel):
     place_edge_margin: float = Field(
         0.10, ge=0, description="A place mark moves at least this far behind the edge (m). 000 4.5."
     )
+    plane_candidate_tilt_deg: float = Field(
+        30.0,
+        gt=0,
+        le=90,
+        description=(
+            "RANSAC draws its hypotheses only from points whose normal lies within this angle of"
+            " vertical (image-space normals scatter by ~12 deg on a table). Ours, for speed."
+        ),
+    )
+    ransac_iterations: int = Field(
+        200, ge=1, description="Plane hypotheses per RANSAC round. Ours."
+    )
+    ransac_sample: int = Field(
+        4000, ge=10, description="Points RANSAC scores hypotheses on before the full count. Ours."
+    )
+    cluster_crop_radius: float = Field(
+        0.3,
+        gt=0,
+        description=(
+            "Only points this close to the mark (m) are clustered; household objects are smaller."
+            " It is also the neighbourhood whose points 002's 90 % rule counts. Ours."
+        ),
+    )
+    regrow_min_height: float = Field(
+        0.004,
+        ge=0,
+        description=(
+            "Removed plane points this far above their plane (m, ~2.6 sigma of the depth noise"
+            " on the table) rejoin the clustering, so objects keep their bottom 1.5 cm and flat"
+            " objects (a phone) survive plane removal. Ours."
+        ),
+    )
+    cluster_noise_points: int = Field(
+        10,
+        ge=1,
+        description="Clusters smaller than this are depth noise, never the target. Ours.",
+    )
+    mark_object_distance: float = Field(
+        0.02,
+        gt=0,
+        description=(
+            "A mark on a support plane with no cluster this close (m) has no object at it. Ours."
+        ),
+    )
+    mark_max_gap: float = Field(
+        0.05, gt=0, description="A mark farther than this (m) from every point sees nothing. Ours."
+    )
+    voi_half_width: float = Field(
+        0.2,
+        gt=0,
+        description=(
+            "Half the side of the square volume of interest around a mark (m): 000 4.4.3's"
+            " 1/4 of the cross-section equals 400 cm^2, so the section is 40 cm x 40 cm."
+        ),
+    )
+    voi_below: float = Field(
+        0.35,
+        gt=0,
+        description=(
+            "The volume of interest reaches this far below the mark (m): down to the support"
+            " under a mark on a 30 cm object, and above the floor under a table. Ours."
+        ),
+    )
+    voi_above: float = Field(
+        0.10, ge=0, description="The volume of interest reaches this far above the mark (m). Ours."
+    )
+    flat_band: float = Field(
+        0.10,
+        gt=0,
+        description="Points within z_top +- this (m) occupy the flat-surface grid. 000 4.4.3.",
+    )
+    surface_band: float = Field(
+        0.02,
+        gt=0,
+        description="Points in [z_top - this, z_top] (m) are the surface region. 000 4.3.2.",
+    )
+    mark_on_surface_tol: float = Field(
+        0.01,
+        gt=0,
+        description=(
+            "A place mark lies on the surface when within this (m) of its height; EL-E's VOI"
+            " test alone also accepts a mark on a cup standing on a table. Ours."
+        ),
+    )
 
 
 class GraspSettings(BaseModel):
@@ -177,6 +268,23 @@ class GraspSettings(BaseModel):
     )
 
 
+class ApproachSettings(BaseModel):
+    """Jeeves' gain-scheduled centroid approach (paper 003 section IV). The paper gives the
+    schedule's distances (20 cm, 7 cm) but not its gains; ours are chosen for a scooter."""
+
+    grasp_spot: tuple[float, float] = Field(
+        (1.45, -0.30), description="Where in `base` (m) the target should end up: before the arm."
+    )
+    kv: float = Field(0.8, gt=0, description="Kv, distance gain (1/s).")
+    kw_far: float = Field(1.2, ge=0, description="Kw beyond far_distance (1/s).")
+    kw_mid: float = Field(0.3, ge=0, description="Kw between near and far distance (1/s).")
+    far_distance: float = Field(0.20, gt=0, description="Gain change, 003: 20 cm (m).")
+    near_distance: float = Field(0.07, gt=0, description="Kw is 0 inside this, 003: 7 cm (m).")
+    tolerance: float = Field(0.02, gt=0, description="Close enough to stop (m).")
+    v_max: float = Field(0.3, gt=0, description="Approach speed limit (m/s).")
+    w_max: float = Field(0.5, gt=0, description="Approach turn-rate limit (rad/s).")
+
+
 class Settings(BaseSettings):
     """All of laserpick's tunable defaults."""
 
@@ -186,6 +294,7 @@ class Settings(BaseSettings):
     sensor: SensorSettings = SensorSettings()
     perception: PerceptionSettings = PerceptionSettings()
     grasp: GraspSettings = GraspSettings()
+    approach: ApproachSettings = ApproachSettings()
 
 
 @lru_cache(maxsize=1)
