@@ -85,6 +85,38 @@ class PerceptionSettings(BaseModel):
     laser_match_m: float = Field(
         0.02, gt=0, description="Views agree on a mark when their 3D points lie this close (m)."
     )
+    laser_spot_min_px: int = Field(
+        3,
+        ge=1,
+        description=(
+            "Fewest saturated pixels a laser spot has; smaller specks are noise. The simulated"
+            " dot (SensorSettings.laser_spot_radius_px 2.5 px) saturates about 20."
+        ),
+    )
+    laser_depth_window_px: int = Field(
+        4,
+        ge=1,
+        description=(
+            "Half-size (px) of the largest window searched for valid depth around a laser spot"
+            " whose own pixel read none; no depth within it fails the spot. 004 section 5.2."
+        ),
+    )
+    laser_beam_separation: float = Field(
+        0.015,
+        gt=0,
+        description=(
+            "Distance (m) between the dual pointer's parallel beams; the confirming beam lies"
+            " this far to the aiming beam's left. 004 section 4 (the device of robot/dims)."
+        ),
+    )
+    laser_origin: tuple[float, float, float] = Field(
+        (0.55, 0.12, 0.95),
+        description=(
+            "Roughly where the seated user holds the pointer, in `base` (m): only the beams'"
+            " rough heading from it is used, to tell the aiming beam (the right one) from the"
+            " confirming one. 004 section 4; the simulated hand position, robot/dims."
+        ),
+    )
     plane_distance: float = Field(
         0.015, gt=0, description="RANSAC plane distance threshold (m). 004 section 6.1."
     )
@@ -108,7 +140,12 @@ class PerceptionSettings(BaseModel):
         0.005, gt=0, description="Euclidean cluster extraction distance (m). 004 section 6.1."
     )
     cluster_min_points: int = Field(
-        500, ge=1, description="A smaller target cluster falls back to the ball. 004 6.1."
+        500,
+        ge=1,
+        description=(
+            "A smaller target cluster falls back to the ball, at 004's full-resolution density;"
+            " scaled like plane_min_inliers: 500 / pixel_stride^2 (125 at stride 2). 004 6.1."
+        ),
     )
     fallback_ball_radius: float = Field(
         0.1, gt=0, description="Radius of the fallback ball around the mark (m). 004 6.1."
@@ -130,6 +167,23 @@ class PerceptionSettings(BaseModel):
     )
     grid_cell_z: float = Field(
         0.0025, gt=0, description="EL-E occupancy grid cell, z (m). 000 section 4.2.2."
+    )
+    grid_surface_margin: float = Field(
+        0.0025,
+        ge=0,
+        description=(
+            "The grid method keeps points this far (m, one grid layer) above EL-E's z_top:"
+            " our depth noise above z_top otherwise joins all objects into one component."
+            " Ours, on 000 4.2.2."
+        ),
+    )
+    grid_min_object_length: float = Field(
+        0.01,
+        gt=0,
+        description="Shorter grid components (m, along max variance) are surface noise. 000 4.2.2.",
+    )
+    grid_max_object_length: float = Field(
+        0.5, gt=0, description="Longer grid components (m) are too large to grasp. 000 4.2.2."
     )
     histogram_bin: float = Field(
         0.0025, gt=0, description="Surface height histogram bin (m). 000 section 4.2.1."
@@ -162,7 +216,7 @@ class PerceptionSettings(BaseModel):
         200, ge=1, description="Plane hypotheses per RANSAC round. Ours."
     )
     ransac_sample: int = Field(
-        4000, ge=10, description="Points RANSAC scores hypotheses on before the full count. Ours."
+        2000, ge=10, description="Points RANSAC scores hypotheses on before the full count. Ours."
     )
     cluster_crop_radius: float = Field(
         0.3,

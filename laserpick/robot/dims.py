@@ -155,14 +155,15 @@ DEPTH_MAX = 3.5  #: m, farthest valid depth
 
 # --- Projector and laser ------------------------------------------------------------------
 
-#: The projector hangs on a bracket from the tall left sensor post, aimed forward, down and
-#: to the right at the middle of the workspace in front of the arm.
-PROJECTOR_POS = (0.98, 0.20, 1.38)
-PROJECTOR_PITCH_DOWN = math.radians(45.0)
-PROJECTOR_YAW = math.radians(-25.0)
+#: The projector hangs on a bracket from the tall left sensor post over the scooter's middle,
+#: aimed down and to the right at the workspace in front of the arm. Its short throw (38 deg
+#: vertical) lights the whole reachable 46 cm table top (x 1.32-1.78, y -0.58-0.28 m).
+PROJECTOR_POS = (0.98, 0.05, 1.38)
+PROJECTOR_PITCH_DOWN = math.radians(59.0)
+PROJECTOR_YAW = math.radians(-20.0)
 PROJECTOR_WIDTH = 1280  #: pixels (EPSON H801A-like WXGA panel)
 PROJECTOR_HEIGHT = 800
-PROJECTOR_FOVY = math.radians(32.0)
+PROJECTOR_FOVY = math.radians(38.0)
 
 #: The laser pointer is held by the seated user, roughly at hand height in front of the seat.
 LASER_ORIGIN = (0.55, 0.12, 0.95)
