@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-FORBIDDEN = ("mujoco", "laserpick.robot", "mink")
+FORBIDDEN = ("mujoco", "laserpick.robot", "laserpick.bench", "mink")
 
 
 def _imports(path: Path) -> list[str]:
@@ -36,7 +36,9 @@ def test_pipeline_imports_neither_mujoco_nor_robot():
         for name in _imports(f)
         if name == "mujoco" or name.startswith(FORBIDDEN)
     ]
-    assert not offenders, "pipeline/ must not see the simulator:\n" + "\n".join(offenders)
+    assert not offenders, "pipeline/ must not see the simulator or its truth:\n" + "\n".join(
+        offenders
+    )
 
 
 def test_import_checker_catches_a_forbidden_import(tmp_path):

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from truth import capture
 
+from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse, voxel_downsample
 from laserpick.pipeline.types import FusedCloud
 from laserpick.settings import PerceptionSettings
@@ -76,11 +76,17 @@ def test_fuse_equals_the_slow_reference(captured, stride):
     s = PerceptionSettings(pixel_stride=stride)
     fast, slow = fuse(captured.frames, s), reference_fuse(captured.frames, s)
     assert fast.cameras == slow.cameras
-    # Same points, same order. Float rounding differs (component-wise vs matmul), so a point
-    # within a hair of the crop box could flip; none does here, and the test says so.
-    np.testing.assert_array_equal(_keys(fast), _keys(slow))
-    np.testing.assert_allclose(fast.points, slow.points, atol=1e-5)
-    np.testing.assert_allclose(fast.normals, slow.normals, atol=1e-4)
+    # Same points, same order. Float rounding differs (component-wise vs matmul), so a pixel
+    # within a hair of a threshold (the crop box, the depth-jump test) may flip: allow one in
+    # 100 000, and compare the rest exactly by key.
+    kf, ks = _keys(fast), _keys(slow)
+    flipped = len(np.setxor1d(kf, ks))
+    assert flipped <= max(1, len(ks) // 100_000), f"{flipped} pixels differ"
+    common, i_fast, i_slow = np.intersect1d(kf, ks, return_indices=True)
+    assert len(common) >= len(ks) - flipped
+    assert np.all(np.diff(i_fast) > 0) and np.all(np.diff(i_slow) > 0)  # same order
+    np.testing.assert_allclose(fast.points[i_fast], slow.points[i_slow], atol=1e-5)
+    np.testing.assert_allclose(fast.normals[i_fast], slow.normals[i_slow], atol=1e-4)
     assert fast.points.dtype == fast.normals.dtype == np.float32
     assert fast.camera.dtype == np.uint8 and fast.pixel.dtype == np.int32
 

@@ -6,8 +6,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from truth import capture
 
+from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark, direct_mark, find_spots, pair_spots
 from laserpick.pipeline.types import Failure, LaserMark
@@ -67,7 +67,7 @@ def test_one_beam_is_aiming_two_are_confirmed(captured):
     c = captured
     cloud = fuse(c.frames)
     rng = np.random.default_rng(3)
-    for instance in ("mug_1", "spice_jar_1", "tv_remote_1"):
+    for instance in [p.instance for p in c.scene.placements[:3]]:
         target = _targets(c, cloud, instance, rng)[0]
         aiming, hit, frames = _mark(c, target, confirm=False)
         assert isinstance(aiming, LaserMark) and aiming.state == "aiming"

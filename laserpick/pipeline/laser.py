@@ -61,6 +61,8 @@ BEAM_OFFSET_TOL = 0.5
 #: A camera vouches for a 3D point when one of its spots lies within this (px) of where the
 #: point projects: about a dot's radius.
 REPROJECT_PX = 3.0
+#: A view vouches for a point only if some depth near its projection lies this close (m).
+DEPTH_AGREE_M = 0.02
 
 
 @dataclass(frozen=True)
@@ -180,10 +182,10 @@ class _View:
     cands: list[_Candidate]
 
     def votes_for(self, point: np.ndarray, tol_px: float) -> tuple[bool, bool]:
-        """(a spot lies within tol_px of where `point` (m, `base`) projects, that spot is one
-        of a pair). A point on the camera's ray through a spot explains that spot, whatever
-        depth the image holds there, so this also counts views whose depth is wrong or
-        missing at the dot."""
+        """(a spot lies within tol_px of where `point` (m, `base`) projects and the depth there
+        does not hide the point, that spot is one of a pair). The depth test is loose (any
+        depth in a small window, or none): a dot on a rim mixes the rim's depth with what lies
+        behind it, and a view must still vouch for the rim."""
         if len(self.uv) == 0:
             return False, False
         T = self.frame.T_base_cam
@@ -194,7 +196,22 @@ class _View:
         uv = np.array([K[0, 0] * q[0] / q[2] + K[0, 2], K[1, 1] * q[1] / q[2] + K[1, 2]])
         d = np.hypot(*(self.uv - uv).T)
         i = int(np.argmin(d))
-        return bool(d[i] <= tol_px), bool(d[i] <= tol_px and self.in_pair[i])
+        if d[i] > tol_px or not self._depth_allows(uv, float(q[2])):
+            return False, False
+        return True, bool(self.in_pair[i])
+
+    def _depth_allows(self, uv: np.ndarray, z: float, half: int = 3) -> bool:
+        """Whether the depth image near pixel `uv` could hold a surface at depth z (m): some
+        valid depth in the window lies within DEPTH_AGREE_M of z, or none is valid. A point
+        behind the surface this camera sees there is hidden from it, so it cannot vouch."""
+        depth = self.frame.depth
+        H, W = depth.shape
+        iu, iv = round(float(uv[0])), round(float(uv[1]))
+        win = depth[
+            max(iv - half, 0) : min(iv + half + 1, H), max(iu - half, 0) : min(iu + half + 1, W)
+        ]
+        valid = win[win > 0]
+        return valid.size == 0 or bool(np.any(np.abs(valid - z) < DEPTH_AGREE_M))
 
 
 def _view(frame: DepthFrame, camera: int, s: PerceptionSettings, origin: np.ndarray) -> _View:
@@ -285,6 +302,8 @@ def _beam_partner(
     left = _left(best.point, origin)
     sep = s.laser_beam_separation
     for g in others:
+        if 2 * len(g.voters) < len(best.voters):
+            continue  # too weakly supported to be the other beam: likely a mis-lifted dot
         offset = float((g.point - best.point) @ left)
         if abs(abs(offset) - sep) <= BEAM_OFFSET_TOL * sep:
             return g, offset < 0
@@ -320,19 +339,28 @@ def detect_mark(
             "I can see the laser dot but can't tell how far away it is; it may be on something"
             " clear, shiny or too far away.",
         )
-    inside = [c for c in cands if np.all((c.point >= lo) & (c.point <= hi))]
+    groups = _scored(cands, views, s)
+    inside = [g for g in groups if np.all((g.point >= lo) & (g.point <= hi))]
     if not inside:
         return Failure(KIND, "The laser dot is outside the area the arm can work in.")
-    groups = _scored(inside, views, s)
-    best, others = groups[0], groups[1:]
+    best = inside[0]
+    # The confirming beam may graze past the target and land far behind it, outside the
+    # workspace: it still tells which beam is which, so look for it among all groups. A group
+    # some view resolved already holds the aiming beam's hit; the partner then only confirms.
+    resolved = any(c.resolved for c in best.members)
+    partner = _beam_partner(best, [g for g in groups if g is not best], s)
+    rivals = [g for g in inside if g is not best]
     by_partner = False
-    partner = _beam_partner(best, others, s)
     if partner is not None:
         group, is_aiming = partner
-        others = [g for g in others if g is not group]
-        best = group if is_aiming else best
+        rivals = [g for g in rivals if g is not group]
         by_partner = True
-    if others and others[0].key[0] == best.key[0] and partner is None:
+        if is_aiming and not resolved:
+            if not any(g is group for g in inside):
+                # The aiming beam, the one the user points with, is off in the distance.
+                return Failure(KIND, "The laser dot is outside the area the arm can work in.")
+            best = group
+    if rivals and rivals[0].key[0] == best.key[0] and partner is None:
         return Failure(
             KIND,
             "The cameras disagree on where the laser dot is; hold the pointer still and try again.",

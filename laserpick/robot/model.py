@@ -452,8 +452,12 @@ def _configure(spec: mujoco.MjSpec) -> None:
     spec.option.noslip_iterations = s.noslip_iterations
     spec.visual.global_.offwidth = max(dims.DEPTH_WIDTH, 1280)
     spec.visual.global_.offheight = max(dims.DEPTH_HEIGHT, 960)
-    spec.visual.map.znear = 0.01
-    spec.visual.map.zfar = 50.0
+    # Clip planes are relative to the model's extent, which a big scene (the 12 surfaces) makes
+    # 40 m; the near plane would then cut table tops 0.4 m from a camera. Fix the extent at the
+    # robot's working scale so the planes sit at 2 cm and 20 m whatever the scene.
+    spec.stat.extent = 5.0
+    spec.visual.map.znear = 0.004
+    spec.visual.map.zfar = 4.0
 
 
 def _add_actuators(spec: mujoco.MjSpec) -> None:

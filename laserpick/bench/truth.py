@@ -1,4 +1,4 @@
-"""Ground truth for scoring the pipeline in tests (never for the pipeline itself).
+"""Ground truth for scoring the pipeline in tests and benchmarks (never for the pipeline).
 
 The simulator knows which geom each depth pixel saw. These helpers carry that label onto the
 fused cloud's points through their (camera, pixel) provenance, and name the object each

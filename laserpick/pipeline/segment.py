@@ -1,0 +1,382 @@
+"""The target object's points at a laser mark: 004 section 6.1, with 002 and EL-E (000) options.
+
+Two methods:
+
+- "cluster" (004 6.1): remove the roughly horizontal planes (RANSAC), extract Euclidean
+  clusters at 5 mm, keep the one nearest the mark; a cluster under 500 points gives way to a
+  0.1 m ball around the mark. 002 II.C adds a guard: a segment that swallowed more than 90 % of
+  the points around the mark has merged with its support, and the 8 cm ball replaces it.
+- "grid" (000 4.2.2): EL-E's surface height histogram, then 26-connected components of a
+  1 x 1 x 0.25 cm occupancy grid of the points above the surface.
+
+Points are float32 (N, 3) in `base` (x forward, y left, z up; metres). Only sensor data comes
+in: the fused cloud and the mark.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from scipy import ndimage
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from laserpick.pipeline.surface import surface_height, voi_mask
+from laserpick.pipeline.types import Failure, FusedCloud, Segmentation, SupportSurface
+from laserpick.settings import PerceptionSettings
+
+NO_OBJECT = "there is no object at the mark"
+NOTHING_SEEN = "the mark is not on anything the sensors can see"
+
+#: 26-connectivity in a 3D grid (000 4.2.2).
+_TWENTY_SIX = np.ones((3, 3, 3), bool)
+
+
+def min_cluster_points(settings: PerceptionSettings) -> int:
+    """Points the target cluster needs before the ball replaces it: 004's 500, scaled.
+
+    Like the plane inliers (see `min_plane_inliers`), 004's 500 counts full-resolution pixels
+    of its Structure sensors; we keep 1 / pixel_stride^2 of them, so 500 / stride^2 (125 at
+    stride 2) asks for the same visible object area.
+    """
+    return max(1, math.ceil(settings.cluster_min_points / settings.pixel_stride**2))
+
+
+# --- horizontal planes (004 6.1) ----------------------------------------------------------------
+
+
+def min_plane_inliers(settings: PerceptionSettings) -> int:
+    """Inliers a plane needs to be removed, scaled from 004's 13k to our cloud's density.
+
+    004 fused five Occipital Structure sensors at full 640 x 480 resolution. We simulate the
+    same sensors on the same mounts (114 cm at 25 and 55 deg down, 156 cm at 44 deg), so a
+    table seen by both systems covers the same pixels; `fuse` keeps every `pixel_stride`-th
+    pixel in each image direction, i.e. 1 / stride^2 of them. 13000 / stride^2 keeps 004's
+    threshold as the same table area (3250 points at stride 2). Voxel thinning
+    (`voxel_size` > 0) is not accounted for.
+    """
+    return max(1, math.ceil(settings.plane_min_inliers / settings.pixel_stride**2))
+
+
+def _plane_through(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normals (up) and offsets d of the planes through point triples p (H, 3, 3)."""
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    norm = np.linalg.norm(n, axis=1)
+    norm[norm == 0] = np.inf  # degenerate triples get a zero normal and lose
+    n = n / norm[:, None]
+    n *= np.where(n[:, 2] < 0, -1.0, 1.0)[:, None]
+    return n, -np.einsum("hk,hk->h", n, p[:, 0])
+
+
+def _refine(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares plane (unit normal up, d) through points (N, 3)."""
+    c = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
+    n = vt[2] if vt[2, 2] >= 0 else -vt[2]
+    return n, -float(n @ c)
+
+
+def _best_horizontal_plane(
+    points: np.ndarray, cand: np.ndarray, settings: PerceptionSettings, rng: np.random.Generator
+) -> np.ndarray | None:
+    """RANSAC for the horizontal plane (a, b, c, d) with the most support, or None.
+
+    `cand` indexes the points whose own normals are near vertical. Hypotheses come from triples
+    of them and are scored on a random sample of them: a table holds most such points, so a
+    few hundred triples find it, and no hypothesis is scored on the whole cloud. The winner is
+    refitted by least squares to its sample inliers; the caller counts its inliers on the full
+    cloud.
+    """
+    if len(cand) < 3:
+        return None
+    pick = cand[rng.integers(0, len(cand), min(len(cand), settings.ransac_sample))]
+    sample = points[pick]
+    tri = sample[rng.integers(0, len(sample), (settings.ransac_iterations, 3))]
+    n, d = _plane_through(tri.astype(np.float64))
+    n[n[:, 2] < math.cos(math.radians(settings.plane_max_tilt_deg))] = 0.0  # too tilted
+    # float32 is ample for mm distances within a few metres, and twice as fast.
+    dist = np.abs(sample @ n.T.astype(np.float32) + d.astype(np.float32))  # (S, H)
+    score = np.count_nonzero(dist <= settings.plane_distance, axis=0)
+    score[n[:, 2] == 0] = 0
+    h = int(np.argmax(score))
+    if score[h] < 3:
+        return None
+    n_ref, d_ref = _refine(sample[dist[:, h] <= settings.plane_distance].astype(np.float64))
+    if n_ref[2] < math.cos(math.radians(settings.plane_max_tilt_deg)):
+        n_ref, d_ref = n[h], float(d[h])
+    return np.array([*n_ref, d_ref])
+
+
+def plane_distance(points: np.ndarray, plane: np.ndarray) -> np.ndarray:
+    """Signed height (m) of points above a plane (a, b, c, d) with a unit normal up."""
+    return points @ plane[:3].astype(np.float32) + np.float32(plane[3])
+
+
+def _height_at_centroid(points: np.ndarray, inliers: np.ndarray, plane: np.ndarray) -> float:
+    """The plane's z (m) at the xy centroid of its inliers (a subsample of them suffices)."""
+    c = points[np.flatnonzero(inliers)[::16], :2].mean(axis=0, dtype=np.float64)
+    return float(-(plane[3] + plane[0] * c[0] + plane[1] * c[1]) / plane[2])
+
+
+def remove_horizontal_planes(
+    cloud: FusedCloud, settings: PerceptionSettings, seed: int = 0
+) -> tuple[np.ndarray, list[SupportSurface]]:
+    """Remove the roughly horizontal planes from the cloud, as 004 6.1 does.
+
+    Repeatedly: RANSAC finds the horizontal plane (normal within `plane_max_tilt_deg`, 5 deg,
+    of vertical) with the most points within `plane_distance` (1.5 cm) among those left; it is
+    removed if it has at least `min_plane_inliers` (13k scaled to our density, see there) and
+    if removing it keeps the total removed at or under `plane_max_removed` (70 %) of the cloud.
+
+    Returns (keep mask (N,) bool: the points that are not on a removed plane, the removed
+    planes as SupportSurfaces, largest first). A plane's height is its z at the centroid of its
+    inliers (m, `base`).
+    """
+    rng = np.random.default_rng(seed)
+    pts = cloud.points
+    keep = np.ones(len(pts), bool)
+    planes: list[SupportSurface] = []
+    budget = int(settings.plane_max_removed * len(pts))
+    need = min_plane_inliers(settings)
+    up = cloud.normals[:, 2] >= math.cos(math.radians(settings.plane_candidate_tilt_deg))
+    cand = np.flatnonzero(up)
+    removed = 0
+    while removed + need <= budget and len(cand) >= 3:
+        plane = _best_horizontal_plane(pts, cand, settings, rng)
+        if plane is None:
+            break
+        inl = keep & (np.abs(plane_distance(pts, plane)) <= settings.plane_distance)
+        count = int(np.count_nonzero(inl))
+        if count < need or removed + count > budget:
+            break
+        keep &= ~inl
+        removed += count
+        cand = cand[keep[cand]]
+        planes.append(SupportSurface(height=_height_at_centroid(pts, inl, plane), plane=plane))
+    return keep, planes
+
+
+# --- Euclidean clusters (004 6.1) -------------------------------------------------------------
+
+
+def euclidean_clusters(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """Euclidean cluster extraction: a label (N,) int per point, from 0; PCL's definition.
+
+    Two points share a cluster when a chain of points, each within `tolerance` (m) of the
+    next, joins them: the connected components of the radius-`tolerance` neighbour graph.
+    Call it on a crop (a few thousand points): cKDTree pairs + sparse components take ~10 ms
+    for 8k points, twice as fast as Open3D's cluster_dbscan(eps, min_points=1), which is the
+    same definition.
+    """
+    n = len(points)
+    if n == 0:
+        return np.zeros(0, np.int64)
+    # An unbalanced, uncompacted tree builds faster and queries as fast for a crop this size.
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    pairs = tree.query_pairs(tolerance, output_type="ndarray")
+    graph = csr_matrix((np.ones(len(pairs), bool), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    # Each pair is stored once; weak components of the directed graph are the clusters.
+    _, labels = connected_components(graph, directed=True, connection="weak")
+    return labels.astype(np.int64)
+
+
+# --- the target -------------------------------------------------------------------------------
+
+
+def _surface_under(
+    points: np.ndarray, mark: np.ndarray, planes: list[SupportSurface], settings
+) -> SupportSurface | None:
+    """The removed plane under the mark: the highest one at or below it (within the plane
+    distance) with inliers among `points` (the crop around the mark); its height at the mark."""
+    best: SupportSurface | None = None
+    for s in planes:
+        h = float(-(s.plane[3] + s.plane[0] * mark[0] + s.plane[1] * mark[1]) / s.plane[2])
+        if h > mark[2] + settings.plane_distance or (best is not None and h <= best.height):
+            continue
+        if np.any(np.abs(plane_distance(points, s.plane)) <= settings.plane_distance):
+            best = SupportSurface(height=h, plane=s.plane)
+    return best
+
+
+def _sq_dist(points: np.ndarray, mark: np.ndarray) -> np.ndarray:
+    """Squared distances (m^2) of the points to the mark."""
+    d = points - mark
+    return np.einsum("ij,ij->i", d, d)
+
+
+def _segment_cluster(
+    cloud: FusedCloud, mark: np.ndarray, d2: np.ndarray, settings: PerceptionSettings
+) -> Segmentation | Failure:
+    """004 6.1's segmentation with our regrowth, and 002's merged-with-support guard.
+
+    `d2`: squared distance (m^2) of every cloud point to the mark.
+    """
+    pts = cloud.points
+    keep, planes = remove_horizontal_planes(cloud, settings)
+    crop = np.flatnonzero(d2 <= settings.cluster_crop_radius**2)
+    crop_pts = pts[crop]
+    surface = _surface_under(crop_pts, mark, planes, settings)
+    # Plane removal at 1.5 cm also strips every object's bottom 1.5 cm (and all of a phone).
+    # Removed points clearly above their plane, beyond the depth noise, rejoin the clustering,
+    # so the cluster regrows into them through the same 5 mm chains. Our addition to 004.
+    cand = keep[crop]
+    for s in planes:
+        h = plane_distance(crop_pts, s.plane)
+        cand |= (h > settings.regrow_min_height) & (h <= settings.plane_distance)
+    idx = crop[cand]
+    labels = euclidean_clusters(pts[idx], settings.cluster_tolerance)
+    sizes = np.bincount(labels, minlength=1)
+    real = np.flatnonzero(sizes[labels] >= settings.cluster_noise_points)
+    nearest = real[np.argmin(d2[idx[real]])] if len(real) else -1
+    gap = math.sqrt(d2[idx[nearest]]) if nearest >= 0 else math.inf
+    on_plane = surface is not None and mark[2] - surface.height <= settings.plane_distance
+    if gap == math.inf or (on_plane and gap > settings.mark_object_distance):
+        # The mark is on a table with nothing standing there (a transparent cup reads as the
+        # table under it): a ball here would be a piece of table.
+        return Failure("precondition", NO_OBJECT)
+    target = idx[labels == labels[nearest]]
+    target = _rejoin_overhangs(pts, target, idx, labels, real, settings)
+    method: Literal["cluster", "ball", "merged_radius"] = "cluster"
+    if len(target) < min_cluster_points(settings):
+        target, method = np.flatnonzero(d2 <= settings.fallback_ball_radius**2), "ball"
+    # 002 II.C: "if more than 90 % of the available points are considered part of the object",
+    # the segment has merged with its support. The available points: the whole cloud (planes
+    # included) within the crop radius of the mark, 30 cm, more than any graspable object
+    # fills, so only a segment that took in its support can hold 90 % of them.
+    if len(target) > settings.merged_fraction * len(crop):
+        target, method = np.flatnonzero(d2 <= settings.merged_radius**2), "merged_radius"
+    return Segmentation(indices=np.sort(target), method=method, surface=surface)
+
+
+def _rejoin_overhangs(
+    pts: np.ndarray,
+    target: np.ndarray,
+    idx: np.ndarray,
+    labels: np.ndarray,
+    real: np.ndarray,
+    settings: PerceptionSettings,
+) -> np.ndarray:
+    """The target plus the clusters an overhang split from it.
+
+    Every sensor looks down, so the underside of an overhang (a doll's chin, a mug's rim
+    over its handle) is never seen, and the object can fall into an upper and a lower
+    cluster more than the 5 mm tolerance apart. A cluster within `occlusion_gap` of the target
+    whose top-down footprint mostly lies inside the target's (or the target's inside its)
+    is taken to be the same object. Objects standing apart on a table do not overlap seen
+    from above, so this does not merge neighbours. Our addition to 004.
+    """
+    if settings.occlusion_gap <= 0:
+        return target
+    tree = cKDTree(pts[target])
+    lo, hi = pts[target, :2].min(axis=0) - 0.005, pts[target, :2].max(axis=0) + 0.005
+    joined = [target]
+    target_label = labels[np.searchsorted(idx, target[0])]
+    for label in np.unique(labels[real]):
+        if label == target_label:
+            continue
+        other = idx[labels == label]
+        if np.min(tree.query(pts[other], distance_upper_bound=settings.occlusion_gap)[0]) > (
+            settings.occlusion_gap
+        ):
+            continue
+        xy = pts[other, :2]
+        inside = np.mean(np.all((xy >= lo) & (xy <= hi), axis=1))
+        olo, ohi = xy.min(axis=0) - 0.005, xy.max(axis=0) + 0.005
+        covered = np.mean(np.all((pts[target, :2] >= olo) & (pts[target, :2] <= ohi), axis=1))
+        if inside > 0.5 or covered > 0.5:
+            joined.append(other)
+    return np.concatenate(joined) if len(joined) > 1 else target
+
+
+def _segment_grid(
+    cloud: FusedCloud, mark: np.ndarray, settings: PerceptionSettings
+) -> Segmentation | Failure:
+    """EL-E's object segmentation (000 4.2.2) in the VOI around the mark.
+
+    The surface top z_top comes from the height histogram (4.2.1); the points above it (plus
+    `grid_surface_margin`, our addition) go into
+    a 3D occupancy grid of `grid_cell_xy` x `grid_cell_xy` x `grid_cell_z` (1 x 1 x 0.25 cm);
+    26-connected components of the occupied cells are the objects (when 1 to 50 cm long, as
+    EL-E requires), and the one with the point nearest the mark is the target.
+    """
+    pts = cloud.points
+    voi = np.nonzero(voi_mask(pts, mark, settings))[0]
+    z_top = surface_height(pts[voi], settings)
+    if z_top is None:
+        return Failure("precondition", NOTHING_SEEN)
+    surface = SupportSurface(height=z_top, plane=np.array([0.0, 0.0, 1.0, -z_top]))
+    # Our margin: EL-E's laser scanner was quieter than our depth sensors (sigma ~1.5 mm at
+    # the table, against 2.5 mm bins), and the table's noise just above z_top fills enough
+    # 1 cm cells to join every object into one 26-connected component. One grid layer more
+    # leaves the noise out.
+    idx = voi[pts[voi, 2] > z_top + settings.grid_surface_margin]
+    if len(idx) == 0:
+        return Failure("precondition", NO_OBJECT)
+    cell = np.array([settings.grid_cell_xy, settings.grid_cell_xy, settings.grid_cell_z])
+    origin = pts[idx].min(axis=0).astype(np.float64)
+    ijk = np.floor((pts[idx] - origin) / cell).astype(np.int64)
+    grid = np.zeros(ijk.max(axis=0) + 1, bool)
+    grid[tuple(ijk.T)] = True
+    labels, _ = ndimage.label(grid, structure=_TWENTY_SIX)
+    point_label = labels[tuple(ijk.T)]
+    d = np.linalg.norm(pts[idx] - mark, axis=1)
+    lab, gap = _nearest_object(pts[idx], point_label, d, settings)
+    on_surface = mark[2] - z_top <= settings.plane_distance
+    target = idx[point_label == lab] if lab else idx[:0]
+    # A few cells of noise are not an object (a clear cup leaves only speckle where it stands).
+    if len(target) < settings.cluster_noise_points or (
+        on_surface and gap > settings.mark_object_distance
+    ):
+        return Failure("precondition", NO_OBJECT)
+    return Segmentation(indices=np.sort(target), method="grid", surface=surface)
+
+
+def _nearest_object(
+    points: np.ndarray, label: np.ndarray, dist: np.ndarray, settings: PerceptionSettings
+) -> tuple[int, float]:
+    """The grid component nearest the mark that EL-E counts as an object, and its distance (m).
+
+    000 4.2.2 rejects components shorter than 1 cm along their direction of maximum variance
+    (noise from the flat surface) or longer than 50 cm (too large to grasp). Components are
+    tried nearest first; (0, inf) when none qualifies.
+    """
+    n = int(label.max()) + 1
+    near = np.full(n, np.inf)
+    np.minimum.at(near, label, dist)
+    for lab in np.argsort(near):
+        if not np.isfinite(near[lab]):
+            break
+        p = points[label == lab].astype(np.float64)
+        if len(p) >= 2:
+            c = p - p.mean(axis=0)
+            axis = np.linalg.svd(c, full_matrices=False)[2][0]
+            length = float(np.ptp(c @ axis))
+            if settings.grid_min_object_length <= length <= settings.grid_max_object_length:
+                return int(lab), float(near[lab])
+    return 0, np.inf
+
+
+def segment_target(
+    cloud: FusedCloud,
+    mark_point: np.ndarray,
+    settings: PerceptionSettings,
+    method: Literal["cluster", "grid"] = "cluster",
+) -> Segmentation | Failure:
+    """The points of the object at the mark (m, `base`), or a Failure that says why not.
+
+    "cluster" is 004 6.1 (with 002's merged guard and our regrowth, see `_segment_cluster`);
+    "grid" is EL-E's occupancy grid (000 4.2.2). Either fails with kind "precondition" when
+    the mark is far from every point, or when it is on a support surface with no object at it.
+    """
+    mark = np.asarray(mark_point, np.float32).reshape(3)
+    if len(cloud) == 0:
+        return Failure("precondition", NOTHING_SEEN)
+    d2 = _sq_dist(cloud.points, mark)
+    if d2.min() > settings.mark_max_gap**2:
+        return Failure("precondition", NOTHING_SEEN)
+    if method == "grid":
+        return _segment_grid(cloud, mark, settings)
+    return _segment_cluster(cloud, mark, d2, settings)

@@ -1,0 +1,269 @@
+"""Target segmentation at a mark (pipeline/segment.py) against the simulator's ground truth.
+
+Each isolation scene is captured once (module fixtures). The mark plays a perfect laser: the
+object's cloud point nearest its top centre. Run with -s to see the per-object figures.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from laserpick.bench.truth import Captured, capture, iou
+from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.segment import (
+    NO_OBJECT,
+    NOTHING_SEEN,
+    euclidean_clusters,
+    min_plane_inliers,
+    remove_horizontal_planes,
+    segment_target,
+)
+from laserpick.pipeline.types import Failure, FusedCloud, Segmentation
+from laserpick.robot.scenes import parse_scene
+from laserpick.settings import PerceptionSettings
+
+SETTINGS = PerceptionSettings()
+SEEDS = (1, 2)
+TABLE_Z = 0.46  # m, the isolation table's top
+
+
+def _top_mark(cap: Captured, cloud: FusedCloud, instance: str) -> tuple[np.ndarray, np.ndarray]:
+    """(truth mask of the object's points, the mark: its point nearest its top centre)."""
+    truth = cap.object_points(cloud, instance)
+    pos, _ = cap.object_pose(instance)  # world; the scooter sits at the world origin here
+    height = cap.scene.placement(instance).model.height
+    top = np.array([pos[0], pos[1], pos[2] + height], np.float32)
+    pts = cloud.points[truth]
+    return truth, pts[np.argmin(np.linalg.norm(pts - top, axis=1))]
+
+
+@pytest.fixture(scope="module", params=SEEDS)
+def isolation(request):
+    cap = capture("isolation", seed=request.param)
+    assert cap.scene.scooter_pose == (0.0, 0.0, 0.0)  # world == base for the truth below
+    cloud = fuse(cap.frames, SETTINGS)
+    marks = {
+        p.instance: _top_mark(cap, cloud, p.instance)
+        for p in cap.scene.placements
+        if p.model.optical == "opaque"
+    }
+    yield request.param, cap, cloud, marks
+    cap.close()
+
+
+def _mask(seg: Segmentation, n: int) -> np.ndarray:
+    m = np.zeros(n, bool)
+    m[seg.indices] = True
+    return m
+
+
+def test_plane_removal_takes_the_table_within_the_papers_limits(isolation):
+    _, _, cloud, _ = isolation
+    keep, planes = remove_horizontal_planes(cloud, SETTINGS)
+    assert len(planes) >= 1
+    table = planes[0]
+    assert abs(table.height - TABLE_Z) < 0.003
+    assert table.plane[2] > np.cos(np.radians(SETTINGS.plane_max_tilt_deg))
+    removed = np.count_nonzero(~keep)
+    assert removed <= SETTINGS.plane_max_removed * len(cloud)
+    assert min_plane_inliers(SETTINGS) == 13000 // SETTINGS.pixel_stride**2
+
+
+def test_cluster_segmentation_iou(isolation):
+    seed, _, cloud, marks = isolation
+    assert len(marks) == 6
+    figures = {}
+    for name, (truth, mark) in marks.items():
+        seg = segment_target(cloud, mark, SETTINGS, method="cluster")
+        assert isinstance(seg, Segmentation), f"{name}: {seg}"
+        figures[name] = (round(iou(_mask(seg, len(cloud)), truth), 3), seg.method)
+        assert seg.surface is not None and abs(seg.surface.height - TABLE_Z) < 0.003
+    print(f"\ncluster IoU, isolation seed {seed}: {figures}")
+    bad = {k: v for k, v in figures.items() if v[0] < 0.9}
+    assert not bad, f"IoU < 0.9: {bad}"
+
+
+def test_grid_segmentation_iou(isolation):
+    """EL-E's grid: median >= 0.9 (no bound per object). It keeps no points below z_top + one grid
+    layer, so low and flat objects lose their bottom ~4 mm of sides; and 26-connected 1 cm
+    cells join objects less than two cells apart (on seed 2 a chip can takes in a neighbour
+    and scores 0.66): EL-E segmented one object at a time. The cluster method is the default
+    and is held to 0.9 for every object."""
+    seed, _, cloud, marks = isolation
+    figures = {}
+    for name, (truth, mark) in marks.items():
+        seg = segment_target(cloud, mark, SETTINGS, method="grid")
+        assert isinstance(seg, Segmentation), f"{name}: {seg}"
+        assert seg.method == "grid"
+        figures[name] = round(iou(_mask(seg, len(cloud)), truth), 3)
+    print(f"\ngrid IoU, isolation seed {seed}: {figures}")
+    assert np.median(list(figures.values())) >= 0.9, figures
+
+
+def test_segment_timing(isolation):
+    seed, _, cloud, marks = isolation
+    times = []
+    for _, mark in marks.values():
+        for _ in range(3):
+            t = time.perf_counter()
+            segment_target(cloud, mark, SETTINGS)
+            times.append(time.perf_counter() - t)
+    print(
+        f"\nsegment_target (cluster) on {len(cloud)} points, seed {seed}:"
+        f" median {1000 * np.median(times):.1f} ms"
+    )
+
+
+def test_mark_in_the_air_fails_clearly(isolation):
+    _, _, cloud, _ = isolation
+    seg = segment_target(cloud, np.array([1.5, 0.0, 1.5]), SETTINGS)
+    assert isinstance(seg, Failure) and seg.kind == "precondition"
+    assert seg.message == NOTHING_SEEN
+
+
+def test_bare_table_has_no_object(isolation):
+    _, _, cloud, marks = isolation
+    objects = np.array([m for _, m in marks.values()])
+    # A table point at least 10 cm from every object.
+    table = np.flatnonzero(np.abs(cloud.points[:, 2] - TABLE_Z) < 0.002)
+    far = np.linalg.norm(cloud.points[table, None, :2] - objects[None, :, :2], axis=2).min(1)
+    mark = cloud.points[table[np.argmax(far > 0.1)]]
+    seg = segment_target(cloud, mark, SETTINGS)
+    assert isinstance(seg, Failure) and seg.message == NO_OBJECT
+
+
+# --- transparent objects ----------------------------------------------------------------------
+
+TRANSPARENT = """
+name: transparent
+scooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}
+surfaces:
+  - {name: table, kind: table, xy: [1.60, -0.15], size: [0.6, 1.0], height: 0.46}
+objects:
+  - {name: glass, model: glass_cup, on: table, xy: [1.45, -0.20]}
+  - {name: bottle, model: water_bottle, on: table, xy: [1.50, 0.10]}
+  - {name: can, model: soda_can, on: table, xy: [1.60, -0.45]}
+"""
+
+
+@pytest.fixture(scope="module")
+def transparent():
+    cap = capture(parse_scene(TRANSPARENT))
+    cloud = fuse(cap.frames, SETTINGS)
+    yield cap, cloud
+    cap.close()
+
+
+@pytest.mark.parametrize("instance", ["glass", "bottle"])
+def test_transparent_object_gives_a_clear_failure(transparent, instance):
+    cap, cloud = transparent
+    pos, _ = cap.object_pose(instance)
+    # The depth sensors see through it: no point stands in its footprint above the table.
+    inside = np.linalg.norm(cloud.points[:, :2] - pos[:2], axis=1) < 0.03
+    assert not np.any(inside & (cloud.points[:, 2] > TABLE_Z + 0.01))
+    # The laser passes through the clear object and lands on the table under it.
+    on_table = np.abs(cloud.points[:, 2] - TABLE_Z) < 0.005
+    pts = cloud.points[on_table]
+    mark = pts[np.argmin(np.linalg.norm(pts[:, :2] - pos[:2], axis=1))]
+    assert np.linalg.norm(mark[:2] - pos[:2]) < 0.05
+    for method in ("cluster", "grid"):
+        seg = segment_target(cloud, mark, SETTINGS, method=method)
+        assert isinstance(seg, Failure), f"{method}: {seg.method}, {len(seg.indices)} points"
+        assert seg.kind == "precondition" and seg.message == NO_OBJECT
+
+
+def test_opaque_neighbour_still_segments(transparent):
+    cap, cloud = transparent
+    truth, mark = _top_mark(cap, cloud, "can")
+    seg = segment_target(cloud, mark, SETTINGS)
+    assert isinstance(seg, Segmentation) and seg.method == "cluster"
+    assert iou(_mask(seg, len(cloud)), truth) > 0.9
+
+
+# --- synthetic clouds ---------------------------------------------------------------------------
+
+
+def _synthetic(points: np.ndarray) -> FusedCloud:
+    n = len(points)
+    normals = np.tile(np.array([0, 0, 1], np.float32), (n, 1))
+    return FusedCloud(
+        points.astype(np.float32),
+        normals,
+        np.zeros(n, np.uint8),
+        np.arange(n, dtype=np.int32),
+        ("synthetic",),
+    )
+
+
+def _box_on_patch(rng: np.random.Generator) -> tuple[np.ndarray, int]:
+    """A 40 x 40 cm table patch at z 0.5 and a 6 x 6 x 8 cm box standing on it, 3 mm spacing,
+    with 1 mm noise: one connected piece at 5 mm. Returns (points, number of box points, which
+    come last)."""
+    g = np.arange(-0.2, 0.2, 0.003)
+    x, y = np.meshgrid(g, g)
+    table = np.column_stack([1.5 + x.ravel(), y.ravel(), np.full(x.size, 0.5)])
+    table = table[~((np.abs(x.ravel()) < 0.03) & (np.abs(y.ravel()) < 0.03))]
+    h = np.arange(0.0, 0.08, 0.003)
+    s = np.arange(-0.03, 0.03, 0.003)
+    sides = [np.column_stack([np.full(s.size, c), s]) for c in (-0.03, 0.03)]
+    sides += [np.column_stack([s, np.full(s.size, c)]) for c in (-0.03, 0.03)]
+    ring = np.concatenate(sides)
+    box = [np.column_stack([1.5 + ring[:, 0], ring[:, 1], np.full(len(ring), 0.5 + z)]) for z in h]
+    sx, sy = np.meshgrid(s, s)
+    box.append(np.column_stack([1.5 + sx.ravel(), sy.ravel(), np.full(sx.size, 0.58)]))
+    box_pts = np.concatenate(box)
+    # A wall 1 m behind, so that the table is less than 70 % of the cloud and may be removed.
+    wy, wz = np.meshgrid(np.arange(-0.6, 0.6, 0.01), np.arange(0.0, 1.0, 0.01))
+    wall = np.column_stack([np.full(wy.size, 2.5), wy.ravel(), wz.ravel()])
+    pts = np.concatenate([wall, table, box_pts])
+    return pts + rng.normal(0, 0.001, pts.shape), len(box_pts)
+
+
+def test_object_merged_with_support_takes_the_8cm_radius():
+    """002 II.C: with the table left in (too few inliers to be removed), the cluster at the mark
+    is table and box together, > 90 % of the points around the mark: use the 8 cm ball."""
+    pts, n_box = _box_on_patch(np.random.default_rng(0))
+    cloud = _synthetic(pts)
+    mark = np.array([1.5, 0.0, 0.58], np.float32)
+    unremovable = SETTINGS.model_copy(update={"plane_min_inliers": 10**9})
+    seg = segment_target(cloud, mark, unremovable)
+    assert isinstance(seg, Segmentation) and seg.method == "merged_radius"
+    d = np.linalg.norm(cloud.points[seg.indices] - mark, axis=1)
+    assert d.max() <= SETTINGS.merged_radius + 1e-6
+    assert len(seg.indices) == np.count_nonzero(
+        np.linalg.norm(cloud.points - mark, axis=1) <= SETTINGS.merged_radius
+    )
+    # With the plane removable, the same cloud gives the box alone.
+    removable = SETTINGS.model_copy(update={"plane_min_inliers": 4 * 1000})
+    seg = segment_target(cloud, mark, removable)
+    assert isinstance(seg, Segmentation) and seg.method == "cluster"
+    truth = np.zeros(len(cloud), bool)
+    truth[-n_box:] = True
+    assert iou(_mask(seg, len(cloud)), truth) > 0.9
+
+
+def test_euclidean_clusters_are_radius_graph_components():
+    rng = np.random.default_rng(1)
+    a = rng.uniform(0, 0.01, (50, 3))
+    line = np.column_stack([np.arange(10) * 0.004 + 0.1, np.zeros(10), np.zeros(10)])
+    pts = np.concatenate([a, line, [[0.2, 0.2, 0.2]]])
+    labels = euclidean_clusters(pts, 0.005)
+    assert len(np.unique(labels[:50])) == 1  # dense blob
+    assert len(np.unique(labels[50:60])) == 1  # a chain of 4 mm steps is one cluster
+    assert len(np.unique(labels)) == 3
+    assert euclidean_clusters(np.zeros((0, 3)), 0.005).shape == (0,)
+
+
+def test_small_cluster_falls_back_to_the_ball():
+    pts, _ = _box_on_patch(np.random.default_rng(2))
+    # A few points standing 3 cm above the table's middle: a 30-point cluster.
+    tuft = np.column_stack([np.full(30, 1.35), np.linspace(0, 0.02, 30), np.full(30, 0.53)])
+    cloud = _synthetic(np.concatenate([pts, tuft]))
+    mark = np.array([1.35, 0.01, 0.53], np.float32)
+    seg = segment_target(cloud, mark, SETTINGS.model_copy(update={"plane_min_inliers": 4000}))
+    assert isinstance(seg, Segmentation) and seg.method == "ball"
+    d = np.linalg.norm(cloud.points[seg.indices] - mark, axis=1)
+    assert d.max() <= SETTINGS.fallback_ball_radius + 1e-6
