@@ -290,8 +290,8 @@ class Simulation:
             done.set()
 
         self._post(apply)
-        if self._thread is not None:
-            done.wait(5.0)
+        if self._thread is not None and not done.wait(5.0):
+            raise TimeoutError("the simulation thread did not run the call within 5 s")
         if err:
             raise err[0]
         return box[0] if box else None
