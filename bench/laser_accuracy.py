@@ -34,9 +34,8 @@ def main() -> None:
             if p.model.optical != "opaque" or len(pts) <= 50:
                 print(f"  seed {seed} {p.instance}: skipped ({p.model.optical}, {len(pts)} points)")
                 continue
-            top = pts[pts[:, 2] > pts[:, 2].max() - 0.005]
             picks = pts[rng.choice(len(pts), args.per_object, replace=False)]
-            for target in [np.median(top, axis=0), *picks]:
+            for target in [c.visible_top(cloud, p.instance), *picks]:
                 c.robot.laser.aim_at(target)
                 c.robot.laser.confirm()
                 mark = detect_mark(c.robot.capture())

@@ -38,11 +38,11 @@ def main() -> None:
         c = capture("isolation", seed=seed)  # also builds the GL context, untimed
         robot, truth_cloud = c.robot, fuse(c.frames)
         for p in c.scene.placements:
-            pts = truth_cloud.points[c.object_points(truth_cloud, p.instance)]
-            if len(pts) == 0:
+            top = c.visible_top(truth_cloud, p.instance)
+            if top is None:
                 print(f"  seed {seed} {p.instance:18s} not visible to any camera: skipped")
                 continue
-            robot.laser.aim_at(np.median(pts[pts[:, 2] > pts[:, 2].max() - 0.005], axis=0))
+            robot.laser.aim_at(top)
             robot.laser.confirm()
             t0 = time.perf_counter()
             frames = robot.capture()

@@ -31,8 +31,7 @@ def main() -> None:
         cloud = fuse(c.frames, s)
         for p in c.scene.placements:
             truth = c.object_points(cloud, p.instance)
-            pts = cloud.points[truth]
-            mark = np.median(pts[pts[:, 2] > pts[:, 2].max() - 0.005], axis=0)
+            mark = c.visible_top(cloud, p.instance)
             seg = segment_target(cloud, mark, s, method=args.method)
             if isinstance(seg, Failure):
                 score, how = 0.0, seg.message

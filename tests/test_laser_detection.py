@@ -37,8 +37,7 @@ def _targets(c, cloud, instance: str, rng) -> list[np.ndarray]:
     five random points the cameras saw on it (mostly its sides facing the scooter)."""
     pts = cloud.points[c.object_points(cloud, instance)]
     assert len(pts) > 50, f"{instance} is barely visible"
-    top = pts[pts[:, 2] > pts[:, 2].max() - 0.005]
-    return [np.median(top, axis=0), *pts[rng.choice(len(pts), 5, replace=False)]]
+    return [c.visible_top(cloud, instance), *pts[rng.choice(len(pts), 5, replace=False)]]
 
 
 def test_marks_on_every_object_are_within_a_centimetre(captured):

@@ -20,9 +20,7 @@ def isolation():
 
 
 def _visible_top(c, instance: str) -> np.ndarray:
-    cloud = fuse(c.frames)
-    pts = cloud.points[c.object_points(cloud, instance)]
-    return np.median(pts[pts[:, 2] > pts[:, 2].max() - 0.005], axis=0)
+    return c.visible_top(fuse(c.frames), instance)
 
 
 def test_laser_marks_segment_each_object(isolation):

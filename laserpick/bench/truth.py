@@ -41,6 +41,14 @@ class Captured:
         """Boolean mask of the cloud points that lie on object `instance`."""
         return self.point_bodies(cloud) == self.robot.sim.info.object_bodies[instance]
 
+    def visible_top(self, cloud: FusedCloud, instance: str) -> np.ndarray | None:
+        """Where a person would aim at `instance`: the middle (median) of the cloud points on
+        it within 5 mm of its highest seen point, in `base` (m). None if no camera saw it."""
+        pts = cloud.points[self.object_points(cloud, instance)]
+        if len(pts) == 0:
+            return None
+        return np.median(pts[pts[:, 2] > pts[:, 2].max() - 0.005], axis=0)
+
     def object_pose(self, instance: str) -> tuple[np.ndarray, np.ndarray]:
         """True position (m) and quaternion (w, x, y, z) of an object, in `world`."""
         b = self.robot.sim.info.object_bodies[instance]
