@@ -106,6 +106,7 @@ class Simulation:
         self.data = mujoco.MjData(self.model)
         self.info = ModelInfo.of(self.model)
         self.arm_model = build_arm_model()
+        self._cartesian = CartesianController(self.arm_model)
         self.dt = float(self.model.opt.timestep)
         self._control_every = max(
             1, round(self.settings.sim.rate_hz / self.settings.sim.control_rate_hz)
@@ -139,7 +140,7 @@ class Simulation:
             d.ctrl[info.gripper_ctrl] = self._grip_set
             self._motion: TrajectoryTracker | CartesianController | None = None
             self._handle: MotionHandle | None = None
-            self._cartesian = CartesianController(self.arm_model)
+            self._cartesian.target = None
             self._cart_tol = (0.001, math.radians(0.5))
             self._cart_deadline = 0.0
             self._drive_cmd = np.zeros(2)
