@@ -330,6 +330,92 @@ class GraspSettings(BaseModel):
         gt=0,
         description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
     )
+    # Hand geometry for grasp detection (collision boxes); robot/dims.py and robot/model.py.
+    pad_depth: float = Field(
+        0.022, gt=0, description="Pad extent along the approach axis (m). robot/dims.py."
+    )
+    pad_width: float = Field(
+        0.022, gt=0, description="Pad extent along the hand axis (m). robot/dims.py."
+    )
+    pad_thickness: float = Field(
+        0.008, gt=0, description="Pad thickness along the closing axis (m). robot/dims.py."
+    )
+    finger_thickness: float = Field(
+        0.008,
+        gt=0,
+        description="Finger plate thickness along the closing axis, outside the pad (m). "
+        "robot/model.py.",
+    )
+    finger_width: float = Field(
+        0.024,
+        gt=0,
+        description="Finger plate extent along the hand axis (m). robot/model.py.",
+    )
+    palm_width: float = Field(
+        0.09, gt=0, description="Palm housing across the closing axis (m). robot/dims.py."
+    )
+    palm_depth: float = Field(
+        0.06, gt=0, description="Palm housing along the hand axis (m). robot/dims.py."
+    )
+    palm_length: float = Field(
+        0.09,
+        gt=0,
+        description="Palm housing along the approach axis, behind the finger roots (m). "
+        "robot/model.py (GRIPPER_BASE_LENGTH less the 1 cm coupling).",
+    )
+    # GPD candidate generation (004 section 6.2; ten Pas et al. 2017 and GPD's defaults).
+    gpd_samples: int = Field(
+        500, ge=1, description="Points sampled from the target to seed candidates. GPD default."
+    )
+    gpd_orientations: int = Field(
+        8, ge=1, description="Hand rotations about the curvature axis per sample. GPD default."
+    )
+    gpd_finger_placements: int = Field(
+        10, ge=1, description="Lateral hand offsets along the closing axis per rotation. GPD."
+    )
+    gpd_nn_radius: float = Field(
+        0.01,
+        gt=0,
+        description="Neighbourhood radius (m) whose normals give a sample's local frame. GPD.",
+    )
+    gpd_frame_neighbours: int = Field(
+        32, ge=3, description="Most neighbours used for a local frame (speed cap). Ours."
+    )
+    gpd_init_bite: float = Field(
+        0.01,
+        ge=0,
+        description="How far (m) the fingertips reach past the sample before deepening. GPD.",
+    )
+    gpd_clearance: float = Field(
+        0.002,
+        ge=0,
+        description="Gap (m) kept before the first contact when pushing the hand in. Ours.",
+    )
+    gpd_friction_deg: float = Field(
+        20.0,
+        gt=0,
+        lt=90,
+        description="Friction cone half-angle (deg) of the antipodal test. GPD's friction_coeff.",
+    )
+    gpd_contact_band: float = Field(
+        0.003,
+        gt=0,
+        description="Points this close (m) to a finger's extreme contact count as contacts. "
+        "GPD's extremal_thresh.",
+    )
+    gpd_min_contacts: int = Field(
+        6, ge=1, description="Antipodal contact points needed on each side. GPD's min_viable."
+    )
+    gpd_collision_voxel: float = Field(
+        0.0,
+        ge=0,
+        description="The scene around the target is thinned to one point per voxel of this edge"
+        " (m) for the collision test, for speed (2x at 5 mm), at the cost of missing points up"
+        " to a voxel inside a hand box; 0 keeps every point (exact). Ours.",
+    )
+    gpd_min_points: int = Field(
+        10, ge=1, description="Object points needed between the pads. Ours."
+    )
 
 
 class ApproachSettings(BaseModel):

@@ -1,0 +1,259 @@
+"""GPD-style grasp candidates on synthetic point clouds (no simulator).
+
+Shapes are sampled on a 3 mm grid with exact outward normals plus a little noise, standing on
+a 4 mm grid of table points at z = 0. Frames: `base`-like, z up, metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.types import Grasp
+from laserpick.settings import GraspSettings
+
+S = GraspSettings()
+SPACING = 0.003  #: m between object points
+FRICTION = math.radians(S.gpd_friction_deg)
+
+
+def table(half: float = 0.3, spacing: float = 0.004) -> np.ndarray:
+    g = np.arange(-half, half, spacing)
+    x, y = np.meshgrid(g, g)
+    return np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+
+
+def noisy(normals: np.ndarray, seed: int = 7, sigma: float = 0.03) -> np.ndarray:
+    """Normals with a little noise, as a sensor's would have (unit length)."""
+    n = normals + np.random.default_rng(seed).normal(0, sigma, normals.shape)
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def cylinder(
+    r: float = 0.03, height: float = 0.12, centre: tuple[float, float] = (0.0, 0.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    """A vertical cylinder's side and top (points, outward normals), standing on z = 0."""
+    ang = np.linspace(0, 2 * np.pi, int(2 * np.pi * r / SPACING), endpoint=False)
+    hh = (np.arange(int(height / SPACING)) + 0.5) * SPACING
+    a, z = np.meshgrid(ang, hh)
+    side = np.column_stack([r * np.cos(a).ravel(), r * np.sin(a).ravel(), z.ravel()])
+    side_n = np.column_stack([np.cos(a).ravel(), np.sin(a).ravel(), np.zeros(a.size)])
+    g = np.arange(-r, r, SPACING)
+    x, y = np.meshgrid(g, g)
+    m = x**2 + y**2 <= r * r
+    top = np.column_stack([x[m], y[m], np.full(m.sum(), height)])
+    pts = np.vstack([side, top])
+    pts[:, :2] += centre
+    return pts, np.vstack([side_n, np.tile([0.0, 0.0, 1.0], (len(top), 1))])
+
+
+def plate(
+    origin: np.ndarray, du: np.ndarray, dv: np.ndarray, normal: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A rectangle origin + s du + t dv (s, t in [0, 1]) of points with one normal."""
+    nu = max(1, int(np.linalg.norm(du) / SPACING))
+    nv = max(1, int(np.linalg.norm(dv) / SPACING))
+    s, t = np.meshgrid((np.arange(nu) + 0.5) / nu, (np.arange(nv) + 0.5) / nv)
+    pts = origin + s.ravel()[:, None] * du + t.ravel()[:, None] * dv
+    return pts, np.tile(normal, (len(pts), 1))
+
+
+def box(
+    size: tuple[float, float, float], centre: tuple[float, float] = (0.0, 0.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    """An axis-aligned box's four sides and top (points, outward normals) on z = 0."""
+    sx, sy, sz = size
+    o = np.array([centre[0] - sx / 2, centre[1] - sy / 2, 0.0])
+    X, Y, Z = np.eye(3)
+    faces = [
+        plate(o + sx * X, sy * Y, sz * Z, X),
+        plate(o, sy * Y, sz * Z, -X),
+        plate(o + sy * Y, sx * X, sz * Z, Y),
+        plate(o, sx * X, sz * Z, -Y),
+        plate(o + sz * Z, sx * X, sy * Y, Z),
+    ]
+    return np.vstack([f[0] for f in faces]), np.vstack([f[1] for f in faces])
+
+
+def detect(target, normals, others=(), seed=0) -> list[Grasp]:
+    scene = np.vstack([table(), target, *others]).astype(np.float32)
+    return detect_grasps(
+        target.astype(np.float32), noisy(normals), scene, S, np.random.default_rng(seed)
+    )
+
+
+def hand_coords(g: Grasp, pts: np.ndarray) -> np.ndarray:
+    """Points in the grasp's frame (hand axis, closing, approach), origin at the fingertips'
+    centre line (the TCP moved pad_depth / 2 forward)."""
+    tips = g.position + g.approach * S.pad_depth / 2
+    return (pts - tips) @ g.pose[:3, :3]
+
+
+def in_fingers(g: Grasp, pts: np.ndarray) -> np.ndarray:
+    """Mask of points inside either finger box (pad plus plate) of the open hand."""
+    h, c, a = hand_coords(g, pts).T
+    thick = S.pad_thickness + S.finger_thickness
+    lateral = (np.abs(c) >= S.width_max / 2) & (np.abs(c) <= S.width_max / 2 + thick)
+    return lateral & (np.abs(h) <= S.finger_width / 2) & (a <= 0) & (a >= -S.finger_length)
+
+
+def in_palm(g: Grasp, pts: np.ndarray) -> np.ndarray:
+    h, c, a = hand_coords(g, pts).T
+    return (
+        (np.abs(c) <= S.palm_width / 2)
+        & (np.abs(h) <= S.palm_depth / 2)
+        & (a <= -S.finger_length)
+        & (a >= -S.finger_length - S.palm_length)
+    )
+
+
+def finger_corners(g: Grasp) -> np.ndarray:
+    """The 16 corners of both finger boxes in `base`."""
+    thick = S.pad_thickness + S.finger_thickness
+    tips = g.position + g.approach * S.pad_depth / 2
+    out = []
+    for h in (-S.finger_width / 2, S.finger_width / 2):
+        for c in (S.width_max / 2 + thick, -S.width_max / 2 - thick):
+            for a in (0.0, -S.finger_length):
+                out.append(tips + h * g.axis + c * g.closing + a * g.approach)
+    return np.array(out)
+
+
+# --- cylinder ------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def cylinder_grasps() -> list[Grasp]:
+    pts, n = cylinder()
+    return detect(pts, n)
+
+
+def test_cylinder_has_grasps_closing_horizontally_through_its_axis(cylinder_grasps):
+    assert len(cylinder_grasps) > 20
+    for g in cylinder_grasps:
+        # Antipodal on a vertical cylinder: the closing axis is within the friction cone of
+        # horizontal, and its line passes near the cylinder's axis.
+        assert abs(g.closing[2]) <= math.sin(FRICTION + math.radians(3))
+        c = g.closing[:2] / np.linalg.norm(g.closing[:2])
+        p = g.position[:2]
+        assert abs(p[0] * c[1] - p[1] * c[0]) < 0.015
+
+
+def test_cylinder_width_is_its_diameter(cylinder_grasps):
+    widths = np.array([g.width for g in cylinder_grasps])
+    assert np.median(widths) == pytest.approx(0.06, abs=0.005)
+    level = [g.width for g in cylinder_grasps if abs(g.closing[2]) < math.sin(math.radians(5))]
+    assert level and np.allclose(level, 0.06, atol=0.005)
+    assert widths.max() <= S.width_max
+
+
+def test_cylinder_grasps_stay_above_the_table(cylinder_grasps):
+    table_pts = table()
+    for g in cylinder_grasps:
+        assert finger_corners(g)[:, 2].min() > 0.0
+        assert not in_fingers(g, table_pts).any() and not in_palm(g, table_pts).any()
+
+
+def test_cylinder_gets_top_and_side_grasps(cylinder_grasps):
+    approach_z = np.array([g.approach[2] for g in cylinder_grasps])
+    assert (approach_z < -0.9).sum() >= 3  # from above
+    assert (np.abs(approach_z) < 0.3).sum() >= 3  # from the side
+
+
+# --- boxes ---------------------------------------------------------------------------------
+
+
+def test_narrow_box_closes_across_its_small_faces():
+    pts, n = box((0.05, 0.03, 0.10))
+    grasps = detect(pts, n)
+    assert grasps
+    for g in grasps:
+        # Across the 3 cm or the 5 cm faces (width up to the friction cone's slant), never
+        # across the 10 cm height.
+        assert g.width <= S.width_max
+        assert min(abs(g.width - 0.03), abs(g.width - 0.05)) < 0.012
+        assert abs(g.closing[2]) < 0.5
+    widths = np.array([g.width for g in grasps])
+    assert (np.abs(widths - 0.03) < 0.005).any() and (np.abs(widths - 0.05) < 0.005).any()
+
+
+def test_wide_box_has_no_grasp_wider_than_the_hand():
+    pts, n = box((0.12, 0.12, 0.12))
+    grasps = detect(pts, n)
+    assert all(0 < g.width <= S.width_max for g in grasps)
+    # Across any face it is 12 cm: nothing may close there.
+    for g in grasps:
+        assert np.max(np.abs(g.closing)) < math.cos(FRICTION)
+
+
+# --- antipodal test ------------------------------------------------------------------------
+
+
+def two_plates(tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Two 4 x 4 cm vertical plates at y = +-2 cm, 5 cm above the table, normals facing out;
+    the +y plate tilted by `tilt_deg` about its horizontal centre line."""
+    X, Y, Z = np.eye(3)
+    a, b = 0.04 * X, 0.04 * Z
+    right = plate(np.array([-0.02, -0.02, 0.05]), a, b, -Y)
+    t = math.radians(tilt_deg)
+    n = math.cos(t) * Y - math.sin(t) * Z  # tilted about x
+    up = math.sin(t) * Y + math.cos(t) * Z
+    centre = np.array([0.0, 0.02, 0.07])
+    left = plate(centre - 0.02 * X - 0.02 * up, a, 0.04 * up, n)
+    return np.vstack([right[0], left[0]]), np.vstack([right[1], left[1]])
+
+
+def test_parallel_plates_are_antipodal():
+    pts, n = two_plates(0.0)
+    grasps = detect(pts, n)
+    assert grasps
+    for g in grasps:
+        assert abs(g.closing[1]) > math.cos(FRICTION)
+        assert g.width == pytest.approx(0.04, abs=0.006)
+
+
+def test_tilted_plate_is_not_antipodal():
+    pts, n = two_plates(60.0)
+    assert detect(pts, n) == []
+
+
+# --- clutter -------------------------------------------------------------------------------
+
+
+def test_neighbour_blocks_fingers():
+    pts, n = cylinder()
+    # A 4 x 4 x 10 cm box 1 cm from the cylinder's side (+x).
+    other, _ = box((0.04, 0.04, 0.10), centre=(0.03 + 0.01 + 0.02, 0.0))
+    grasps = detect(pts, n, others=(other,))
+    assert grasps
+    for g in grasps:
+        assert not in_fingers(g, other).any()
+        assert not in_palm(g, other).any()
+    # Side grasps closing straight along x below the box's top would put a finger through it.
+    assert not any(
+        abs(g.closing[0]) > 0.98 and abs(g.approach[2]) < 0.3 and g.position[2] < 0.09
+        for g in grasps
+    )
+
+
+# --- determinism ---------------------------------------------------------------------------
+
+
+def test_same_seed_same_grasps():
+    pts, n = cylinder()
+    a, b = detect(pts, n, seed=3), detect(pts, n, seed=3)
+    assert len(a) == len(b)
+    assert all(
+        np.array_equal(x.pose, y.pose) and x.width == y.width for x, y in zip(a, b, strict=True)
+    )
+    c = detect(pts, n, seed=4)
+    assert len(c) != len(a) or any(
+        not np.array_equal(x.pose, y.pose) for x, y in zip(a, c, strict=False)
+    )
+
+
+def test_tiny_target_gives_nothing():
+    assert detect_grasps(np.zeros((2, 3)), np.zeros((2, 3)), table()) == []
