@@ -372,3 +372,19 @@ def test_bound_to_one_thread(world):
         t.start()
         t.join()
         assert len(errors) == 1
+
+
+def test_laser_refuses_non_finite_aims_and_keeps_its_state():
+    from laserpick.robot.laser import LaserPointer
+    from laserpick.robot.model import build_sim_model
+
+    laser = LaserPointer(build_sim_model(None))
+    before = laser.aim(0.1, -0.3)
+    for bad in ((float("nan"), 0.0), (0.0, float("inf"))):
+        with pytest.raises(ValueError, match="finite"):
+            laser.aim(*bad)
+    with pytest.raises(ValueError, match="finite"):
+        laser.nudge(float("nan"), 0.0)
+    with pytest.raises(ValueError, match="finite"):
+        laser.aim_at(np.array([np.nan, 0.0, 0.5]))
+    assert laser.state == before

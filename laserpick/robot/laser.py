@@ -23,7 +23,9 @@ Plain state, no locks: one `LaserPointer` lives on the simulation thread.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import threading
 from dataclasses import dataclass
 
 import mujoco
@@ -66,8 +68,18 @@ def _clamp(x: float, lo: float, hi: float) -> float:
     return min(max(float(x), lo), hi)
 
 
+def _finite(**values: float) -> None:
+    for name, v in values.items():
+        if not math.isfinite(float(v)):
+            raise ValueError(f"laser {name} must be a finite number, got {v!r}")
+
+
 class LaserPointer:
-    """The simulated dual laser pointer. Starts off, pointing straight ahead and level."""
+    """The simulated dual laser pointer. Starts off, pointing straight ahead and level.
+
+    Safe to aim from one thread while another casts: the state is one immutable `LaserState`,
+    swapped whole under a lock, and every reader works from one snapshot of it.
+    """
 
     def __init__(self, model: mujoco.MjModel) -> None:
         self._site = model.site(LASER_SITE).id
@@ -76,17 +88,15 @@ class LaserPointer:
             raise ValueError(f"site {LASER_SITE!r} must be fixed to body {SCOOTER_BODY!r}")
         # The site is a direct child of the scooter body, so its local position is in `base`.
         self._origin_base = np.array(model.site_pos[self._site], dtype=float)
-        self._on = False
-        self._confirmed = False
-        self._yaw = 0.0
-        self._pitch = 0.0
+        self._st = LaserState(on=False, confirmed=False, yaw=0.0, pitch=0.0)
+        self._lock = threading.Lock()
 
     # --- state ------------------------------------------------------------------------------
 
     @property
     def state(self) -> LaserState:
         """A snapshot of the pointer's state."""
-        return LaserState(self._on, self._confirmed, self._yaw, self._pitch)
+        return self._st
 
     @property
     def origin_base(self) -> np.ndarray:
@@ -98,52 +108,67 @@ class LaserPointer:
 
         Moving the pointer drops any confirmation: the user re-confirms after re-aiming.
         """
-        self._yaw = _clamp(yaw, -dims.LASER_YAW_LIMIT, dims.LASER_YAW_LIMIT)
-        self._pitch = _clamp(pitch, dims.LASER_PITCH_MIN, dims.LASER_PITCH_MAX)
-        self._on = True
-        self._confirmed = False
-        return self.state
+        _finite(yaw=yaw, pitch=pitch)
+        with self._lock:
+            self._st = self._aimed(yaw, pitch)
+            return self._st
+
+    @staticmethod
+    def _aimed(yaw: float, pitch: float) -> LaserState:
+        return LaserState(
+            on=True,
+            confirmed=False,
+            yaw=_clamp(yaw, -dims.LASER_YAW_LIMIT, dims.LASER_YAW_LIMIT),
+            pitch=_clamp(pitch, dims.LASER_PITCH_MIN, dims.LASER_PITCH_MAX),
+        )
 
     def aim_at(self, point_base: np.ndarray) -> LaserState:
         """Aim the first beam at a point in `base` (m), as far as the limits allow."""
         v = np.asarray(point_base, dtype=float).reshape(3) - self._origin_base
+        _finite(x=v[0], y=v[1], z=v[2])
         yaw = math.atan2(v[1], v[0])
         pitch = math.atan2(v[2], math.hypot(v[0], v[1]))
         return self.aim(yaw, pitch)
 
     def nudge(self, dyaw: float, dpitch: float) -> LaserState:
         """Turn the pointer by (dyaw, dpitch) rad from where it points; lights the aiming beam."""
-        return self.aim(self._yaw + dyaw, self._pitch + dpitch)
+        _finite(dyaw=dyaw, dpitch=dpitch)
+        with self._lock:
+            self._st = self._aimed(self._st.yaw + dyaw, self._st.pitch + dpitch)
+            return self._st
 
     def confirm(self) -> LaserState:
         """Light the second beam. Does nothing while the pointer is off."""
-        if self._on:
-            self._confirmed = True
-        return self.state
+        with self._lock:
+            if self._st.on:
+                self._st = dataclasses.replace(self._st, confirmed=True)
+            return self._st
 
     def off(self) -> LaserState:
         """Switch both beams off; the aim is kept."""
-        self._on = False
-        self._confirmed = False
-        return self.state
+        with self._lock:
+            self._st = dataclasses.replace(self._st, on=False, confirmed=False)
+            return self._st
 
     # --- geometry ---------------------------------------------------------------------------
 
-    def direction_base(self) -> np.ndarray:
-        """Unit direction of both beams in `base`."""
-        cp = math.cos(self._pitch)
-        return np.array([cp * math.cos(self._yaw), cp * math.sin(self._yaw), math.sin(self._pitch)])
+    def direction_base(self, st: LaserState | None = None) -> np.ndarray:
+        """Unit direction of both beams in `base` (for `st`, default the current state)."""
+        st = st or self._st
+        cp = math.cos(st.pitch)
+        return np.array([cp * math.cos(st.yaw), cp * math.sin(st.yaw), math.sin(st.pitch)])
 
     def beams_base(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """(origin m, unit direction) in `base` of each lit beam: none, one or two."""
-        if not self._on:
+        st = self._st  # one snapshot: another thread may re-aim meanwhile
+        if not st.on:
             return []
-        d = self.direction_base()
+        d = self.direction_base(st)
         out = [(self._origin_base.copy(), d)]
-        if self._confirmed:
+        if st.confirmed:
             # Horizontal and perpendicular to the beam, to its left; this is well defined even
             # for a beam pointing nearly straight down, since it depends on yaw only.
-            left = np.array([-math.sin(self._yaw), math.cos(self._yaw), 0.0])
+            left = np.array([-math.sin(st.yaw), math.cos(st.yaw), 0.0])
             out.append((self._origin_base + dims.LASER_BEAM_SEPARATION * left, d.copy()))
         return out
 
