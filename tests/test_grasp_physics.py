@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.robot import dims
 from laserpick.robot import kinematics as K
@@ -58,10 +59,8 @@ objects:
 
 
 def _joint_path(q0: np.ndarray, q1: np.ndarray, speed: float) -> Trajectory:
-    dur = max(0.3, float(np.max(np.abs(q1 - q0))) / speed)
-    t = np.linspace(0.0, dur, 40)
-    s = 0.5 - 0.5 * np.cos(np.pi * t / dur)
-    return Trajectory(times=t, q=q0 + s[:, None] * (q1 - q0))
+    """A rest-to-rest joint move at up to `speed` rad/s, timed by the pipeline's own planner."""
+    return time_parametrize(np.stack([q0, q1]), v_max=speed, a_max=dims.UR5_QDD_MAX)
 
 
 def _top_down_grasp(obj_pos: np.ndarray, obj_quat: np.ndarray, model) -> np.ndarray:

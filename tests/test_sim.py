@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 
+from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import GripperEvent, Trajectory
 from laserpick.robot import dims
 from laserpick.robot import kinematics as K
@@ -24,10 +25,8 @@ def sim():
 
 
 def _line(q0: np.ndarray, q1: np.ndarray, speed: float = 0.5) -> Trajectory:
-    dur = max(0.2, float(np.max(np.abs(q1 - q0))) / speed)
-    t = np.linspace(0.0, dur, 50)
-    s = 0.5 - 0.5 * np.cos(np.pi * t / dur)  # smooth start and stop
-    return Trajectory(times=t, q=q0 + s[:, None] * (q1 - q0))
+    """A rest-to-rest joint move at up to `speed` rad/s, timed by the pipeline's own planner."""
+    return time_parametrize(np.stack([q0, q1]), v_max=speed, a_max=dims.UR5_QDD_MAX)
 
 
 def test_contact_options_hold_a_parallel_jaw_grasp(sim):

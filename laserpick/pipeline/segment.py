@@ -237,8 +237,7 @@ def _segment_cluster(
         # The mark is on a table with nothing standing there (a transparent cup reads as the
         # table under it): a ball here would be a piece of table.
         return Failure("precondition", NO_OBJECT)
-    target = idx[labels == labels[nearest]]
-    target = _rejoin_overhangs(pts, target, idx, labels, real, settings)
+    target = _rejoin_overhangs(pts, idx, labels, labels[nearest], real, settings)
     method: Literal["cluster", "ball", "merged_radius"] = "cluster"
     if len(target) < min_cluster_points(settings):
         target, method = np.flatnonzero(d2 <= settings.fallback_ball_radius**2), "ball"
@@ -253,13 +252,14 @@ def _segment_cluster(
 
 def _rejoin_overhangs(
     pts: np.ndarray,
-    target: np.ndarray,
     idx: np.ndarray,
     labels: np.ndarray,
+    target_label: int,
     real: np.ndarray,
     settings: PerceptionSettings,
 ) -> np.ndarray:
-    """The target plus the clusters an overhang split from it.
+    """Cloud indices of the target cluster (`idx[labels == target_label]`) plus the clusters
+    an overhang split from it.
 
     Every sensor looks down, so the underside of an overhang (a doll's chin, a mug's rim
     over its handle) is never seen, and the object can fall into an upper and a lower
@@ -268,12 +268,12 @@ def _rejoin_overhangs(
     is taken to be the same object. Objects standing apart on a table do not overlap seen
     from above, so this does not merge neighbours. Our addition to 004.
     """
+    target = idx[labels == target_label]
     if settings.occlusion_gap <= 0:
         return target
     tree = cKDTree(pts[target])
     lo, hi = pts[target, :2].min(axis=0) - 0.005, pts[target, :2].max(axis=0) + 0.005
     joined = [target]
-    target_label = labels[np.searchsorted(idx, target[0])]
     for label in np.unique(labels[real]):
         if label == target_label:
             continue

@@ -92,14 +92,19 @@ def _geom(body: mujoco.MjsBody, name: str, kind: mujoco.mjtGeom, size, pos=(0, 0
 def _capsule_between(
     body: mujoco.MjsBody, name: str, a, b, radius: float, mass: float, rgba=ROBOT_RGBA
 ) -> mujoco.MjsGeom:
-    g = body.add_geom(name=name, type=G.mjGEOM_CAPSULE)
-    g.fromto = list(a) + list(b)
-    g.size = [radius, 0, 0]
-    g.mass = mass
-    g.rgba = list(rgba)
-    g.group = GROUP_ROBOT
-    g.contype, g.conaffinity = ARM_TYPE, ARM_AFFINITY
-    return g
+    """An arm collision capsule from point a to point b in the body's frame (m)."""
+    return _geom(
+        body,
+        name,
+        G.mjGEOM_CAPSULE,
+        (radius,),
+        fromto=[*a, *b],
+        mass=mass,
+        rgba=list(rgba),
+        group=GROUP_ROBOT,
+        contype=ARM_TYPE,
+        conaffinity=ARM_AFFINITY,
+    )
 
 
 # --- the arm ----------------------------------------------------------------------------------
@@ -248,7 +253,8 @@ def _add_gripper(flange: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
 # --- the scooter ------------------------------------------------------------------------------
 
 
-def _shell(body: mujoco.MjsBody, name: str, kind, size, pos, rgba=SCOOTER_RGBA, quat=None):
+def _shell(body: mujoco.MjsBody, name: str, kind, size, pos, rgba=SCOOTER_RGBA, quat=None, **kw):
+    """A massless geom of the scooter's shell, in `base`."""
     g = _geom(
         body,
         SCOOTER_COLLISION_PREFIX + name,
@@ -260,6 +266,7 @@ def _shell(body: mujoco.MjsBody, name: str, kind, size, pos, rgba=SCOOTER_RGBA, 
         contype=SCOOTER_TYPE,
         conaffinity=SCOOTER_AFFINITY,
         mass=0.0,
+        **kw,
     )
     if quat is not None:
         g.quat = list(quat)
@@ -267,13 +274,8 @@ def _shell(body: mujoco.MjsBody, name: str, kind, size, pos, rgba=SCOOTER_RGBA, 
 
 
 def _shell_capsule(body: mujoco.MjsBody, name: str, a, b, radius: float, rgba=DARK_RGBA) -> None:
-    g = body.add_geom(name=SCOOTER_COLLISION_PREFIX + name, type=G.mjGEOM_CAPSULE)
-    g.fromto = [*a, *b]
-    g.size = [radius, 0, 0]
-    g.rgba = list(rgba)
-    g.group = GROUP_ROBOT
-    g.contype, g.conaffinity = SCOOTER_TYPE, SCOOTER_AFFINITY
-    g.mass = 0.0
+    """A shell capsule from point a to point b in `base` (m)."""
+    _shell(body, name, G.mjGEOM_CAPSULE, (radius,), (0, 0, 0), rgba, fromto=[*a, *b])
 
 
 def _add_scooter_shell(body: mujoco.MjsBody) -> None:
