@@ -3,7 +3,7 @@
 Values are read from `LASERPICK_*` environment variables; nested groups use a double
 underscore, e.g. `LASERPICK_SIM__RATE_HZ=250` or `LASERPICK_SENSOR__DEPTH_NOISE_K=0.002`.
 Hardware limits (joint ranges, speeds, stroke) are not settings: they are facts of the
-robot and live in `laserpick.robot.dims`.
+robot and live in `laserpick.description.dims`.
 """
 
 from __future__ import annotations
@@ -106,7 +106,7 @@ class PerceptionSettings(BaseModel):
         gt=0,
         description=(
             "Distance (m) between the dual pointer's parallel beams; the confirming beam lies"
-            " this far to the aiming beam's left. 004 section 4 (the device of robot/dims)."
+            " this far to the aiming beam's left. 004 section 4 (the device of description/dims)."
         ),
     )
     laser_origin: tuple[float, float, float] = Field(
@@ -114,7 +114,7 @@ class PerceptionSettings(BaseModel):
         description=(
             "Roughly where the seated user holds the pointer, in `base` (m): only the beams'"
             " rough heading from it is used, to tell the aiming beam (the right one) from the"
-            " confirming one. 004 section 4; the simulated hand position, robot/dims."
+            " confirming one. 004 section 4; the simulated hand position, description/dims."
         ),
     )
     plane_distance: float = Field(
@@ -302,7 +302,7 @@ class PerceptionSettings(BaseModel):
 class GraspSettings(BaseModel):
     """Grasp selection parameters (paper 004 section 7) and the hand geometry the pipeline uses.
 
-    The hand geometry mirrors the gripper in `laserpick.robot.dims` (a test holds them equal);
+    The hand geometry mirrors the gripper in `laserpick.description.dims` (a test holds them equal);
     it is repeated here because pipeline/ may not import robot/.
     """
 
@@ -330,15 +330,15 @@ class GraspSettings(BaseModel):
         gt=0,
         description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
     )
-    # Hand geometry for grasp detection (collision boxes); robot/dims.py and robot/model.py.
+    # Hand geometry for grasp detection (collision boxes); description/dims.py and robot/model.py.
     pad_depth: float = Field(
-        0.022, gt=0, description="Pad extent along the approach axis (m). robot/dims.py."
+        0.022, gt=0, description="Pad extent along the approach axis (m). description/dims.py."
     )
     pad_width: float = Field(
-        0.022, gt=0, description="Pad extent along the hand axis (m). robot/dims.py."
+        0.022, gt=0, description="Pad extent along the hand axis (m). description/dims.py."
     )
     pad_thickness: float = Field(
-        0.008, gt=0, description="Pad thickness along the closing axis (m). robot/dims.py."
+        0.008, gt=0, description="Pad thickness along the closing axis (m). description/dims.py."
     )
     finger_thickness: float = Field(
         0.008,
@@ -352,10 +352,10 @@ class GraspSettings(BaseModel):
         description="Finger plate extent along the hand axis (m). robot/model.py.",
     )
     palm_width: float = Field(
-        0.09, gt=0, description="Palm housing across the closing axis (m). robot/dims.py."
+        0.09, gt=0, description="Palm housing across the closing axis (m). description/dims.py."
     )
     palm_depth: float = Field(
-        0.06, gt=0, description="Palm housing along the hand axis (m). robot/dims.py."
+        0.06, gt=0, description="Palm housing along the hand axis (m). description/dims.py."
     )
     palm_length: float = Field(
         0.09,
@@ -435,6 +435,52 @@ class ApproachSettings(BaseModel):
     w_max: float = Field(0.5, gt=0, description="Approach turn-rate limit (rad/s).")
 
 
+class MotionSettings(BaseModel):
+    """Planning and execution of picks and places (004 section 7.3-7.4; 000 section 4.6; 002)."""
+
+    joint_speed: float = Field(
+        1.0,
+        gt=0,
+        le=3.14,
+        description="Joint speed limit (rad/s) near people; the UR5 can do 3.14. 004 issue text.",
+    )
+    joint_accel: float = Field(1.5, gt=0, le=3.0, description="Joint acceleration (rad/s^2).")
+    tcp_speed: float = Field(0.25, gt=0, description="TCP speed limit near people (m/s).")
+    approach_speed: float = Field(
+        0.08, gt=0, description="TCP speed (m/s) on the last, guarded approach to a grasp. Ours."
+    )
+    approach_distance: float = Field(
+        0.10, gt=0, description="Pre-grasp stand-off along the approach axis (m). 004 section 7."
+    )
+    regrip_lift: float = Field(
+        0.02, ge=0, description="Lift (m) before closing again: the re-grip of 002."
+    )
+    lift: float = Field(0.10, gt=0, description="Lift (m) after the grasp. 000 section 4.6.")
+    guard_force: float = Field(
+        25.0,
+        gt=0,
+        description="Contact force (N) on the arm or the hand's outside that stops a guarded"
+        " approach, as a protective stop would. Ours.",
+    )
+    backoff: float = Field(0.05, gt=0, description="Retreat (m) after an unexpected contact.")
+    clearance: float = Field(
+        0.01, ge=0, description="Clearance (m) kept between the arm's spheres and the cloud."
+    )
+    cartesian_step: float = Field(
+        0.01, gt=0, description="Waypoint spacing (m) of straight-line Cartesian paths."
+    )
+    rrt_max_samples: int = Field(
+        2000, ge=10, description="Samples before the joint-space planner gives up."
+    )
+    rrt_step: float = Field(0.3, gt=0, description="RRT-Connect extension step (rad).")
+    drop_height: float = Field(
+        0.16, gt=0, description="TCP height (m) above the basket's rim when releasing."
+    )
+    place_clearance: float = Field(
+        0.01, ge=0, description="Height (m) above the computed resting pose to release at."
+    )
+
+
 class Settings(BaseSettings):
     """All of laserpick's tunable defaults."""
 
@@ -445,6 +491,7 @@ class Settings(BaseSettings):
     perception: PerceptionSettings = PerceptionSettings()
     grasp: GraspSettings = GraspSettings()
     approach: ApproachSettings = ApproachSettings()
+    motion: MotionSettings = MotionSettings()
 
 
 @lru_cache(maxsize=1)

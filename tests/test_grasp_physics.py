@@ -12,10 +12,10 @@ import math
 import numpy as np
 import pytest
 
+from laserpick.description import dims
+from laserpick.description import kinematics as K
 from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import Trajectory
-from laserpick.robot import dims
-from laserpick.robot import kinematics as K
 from laserpick.robot.objects import LIBRARY, min_width, support
 from laserpick.robot.scenes import parse_scene
 from laserpick.robot.sim import Simulation

@@ -10,8 +10,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from laserpick.robot import dims
-from laserpick.robot import kinematics as K
+from laserpick.description import dims
+from laserpick.description import kinematics as K
 from laserpick.robot.model import TCP_SITE, build_arm_model, build_arm_spec
 from laserpick.transforms import rotation_angle
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from laserpick.bench.truth import capture
+from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.projector import (
     Projector,
@@ -17,7 +18,6 @@ from laserpick.pipeline.projector import (
     highlight_points,
     projector_intrinsics,
 )
-from laserpick.robot import dims
 from laserpick.robot.model import PROJECTOR_CAMERA
 from laserpick.robot.sensors import CAM_TO_OPTICAL
 from laserpick.transforms import make_transform, pinhole_intrinsics

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
+from laserpick.description import dims
 from laserpick.pipeline import selection as sel
 from laserpick.pipeline.types import Grasp
-from laserpick.robot import dims
 from laserpick.settings import GraspSettings
 
 S = GraspSettings()

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
+from laserpick.description import dims
 from laserpick.pipeline.types import DepthFrame
-from laserpick.robot import dims
 from laserpick.robot.laser import LaserPointer
 from laserpick.robot.model import ModelInfo, build_sim_spec
 from laserpick.robot.sensors import DepthCameras

@@ -9,10 +9,10 @@ import time
 import numpy as np
 import pytest
 
+from laserpick.description import dims
+from laserpick.description import kinematics as K
 from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import GripperEvent, Trajectory
-from laserpick.robot import dims
-from laserpick.robot import kinematics as K
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim import Simulation
 

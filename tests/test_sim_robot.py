@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from laserpick.robot import dims
+from laserpick.description import dims
 from laserpick.robot.interface import Robot
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from laserpick.description import kinematics as K
 from laserpick.pipeline.timing import time_parametrize
-from laserpick.robot import kinematics as K
 
 
 def _rates(traj):

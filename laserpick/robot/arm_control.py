@@ -14,8 +14,8 @@ import mink
 import mujoco
 import numpy as np
 
+from laserpick.description import dims
 from laserpick.pipeline.trajectory import GripperEvent, Trajectory
-from laserpick.robot import dims
 from laserpick.robot.model import ARM_JOINTS, ARM_PREFIX, SCOOTER_COLLISION_PREFIX, TCP_SITE
 from laserpick.transforms import rotation_angle
 

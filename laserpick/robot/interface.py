@@ -55,6 +55,14 @@ class Robot(Protocol):
         """Start tracking a joint trajectory; the handle reports done, stopped or failed."""
         ...
 
+    def wait(self, handle: MotionHandle, timeout: float) -> str:
+        """Block until the motion ends or `timeout` s of robot time pass; its status."""
+        ...
+
+    def sleep(self, seconds: float) -> None:
+        """Let `seconds` of robot time pass (the gripper closing, an object settling)."""
+        ...
+
     def gripper(self, close: bool) -> None:
         """Close to the force limit, or open fully."""
         ...

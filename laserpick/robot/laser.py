@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from laserpick.robot import dims
+from laserpick.description import dims
 from laserpick.robot.model import LASER_SITE, SCOOTER_BODY
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR
 

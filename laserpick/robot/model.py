@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from laserpick.robot import dims
+from laserpick.description import dims
+from laserpick.description.collision import LINK_CAPSULES
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT
 from laserpick.robot.scenes import Scene, add_scene_to_spec
 from laserpick.settings import get_settings
@@ -121,21 +122,6 @@ def _add_ur5(parent: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
     )
     _capsule_between(base, ARM_PREFIX + "base/c", (0, 0, 0.0), (0, 0, 0.03), r[0], m[0], DARK_RGBA)
 
-    # Physical link offsets along each joint axis (m): the UR5's shoulder and elbow sit to the
-    # side of the DH line; the DH d4 is their net sum. Used for collision capsules only.
-    shoulder_off, elbow_off = 0.13585, 0.1197
-    link_geoms = [
-        # (from, to, radius) in body i's frame (frame i-1 turned by q_i)
-        [((0, 0, 0.0), (0, 0, d[0]), r[1])],
-        [
-            ((0, 0, 0.0), (0, 0, shoulder_off), r[2]),
-            ((0, 0, shoulder_off), (a[1], 0, shoulder_off), r[2]),
-        ],
-        [((0, 0, shoulder_off - elbow_off), (a[2], 0, shoulder_off - elbow_off), r[3])],
-        [((0, 0, shoulder_off - elbow_off), (0, 0, d[3]), r[4])],
-        [((0, 0, 0.0), (0, 0, d[4]), r[5])],
-        [((0, 0, 0.0), (0, 0, d[5] - 0.005), r[6])],
-    ]
     body = base
     for i in range(6):
         if i == 0:
@@ -149,8 +135,8 @@ def _add_ur5(parent: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         j.armature = 0.1 if i < 3 else 0.02
         j.damping = [1.0 if i < 3 else 0.2, 0.0, 0.0]
-        share = m[i + 1] / len(link_geoms[i])
-        for k, (p0, p1, rad) in enumerate(link_geoms[i]):
+        share = m[i + 1] / len(LINK_CAPSULES[i])
+        for k, (p0, p1, rad) in enumerate(LINK_CAPSULES[i]):
             if np.allclose(p0, p1):
                 p1 = (p1[0], p1[1], p1[2] + 1e-3)
             _capsule_between(body, ARM_PREFIX + f"link{i + 1}/c{k}", p0, p1, rad, share)
@@ -510,6 +496,7 @@ class ModelInfo:
     laser_site: int
     scooter_body: int
     pad_geoms: np.ndarray
+    arm_geoms: np.ndarray  #: every geom of the arm and the gripper, pads included
     camera_ids: dict[str, int]
     object_bodies: dict[str, int]  #: instance name -> body id
 
@@ -542,9 +529,18 @@ class ModelInfo:
             laser_site=m.site(LASER_SITE).id,
             scooter_body=m.body(SCOOTER_BODY).id,
             pad_geoms=np.array([m.geom(f"gripper/pad_{s}").id for s in ("left", "right")]),
+            arm_geoms=_subtree_geoms(m, m.body(ARM_PREFIX + "base").id),
             camera_ids={c.name: m.camera(c.name).id for c in dims.CAMERA_MOUNTS},
             object_bodies=objects,
         )
+
+
+def _subtree_geoms(m: mujoco.MjModel, root: int) -> np.ndarray:
+    """Ids of the geoms of body `root` and of all bodies below it."""
+    inside = np.zeros(m.nbody, bool)
+    for b in range(m.nbody):  # parents come before their children
+        inside[b] = b == root or (b > 0 and inside[m.body_parentid[b]])
+    return np.flatnonzero(inside[m.geom_bodyid])
 
 
 def build_sim_spec(scene: Scene | None) -> mujoco.MjSpec:

@@ -61,7 +61,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from laserpick.robot import dims
+from laserpick.description import dims
 from laserpick.robot.objects import (
     GROUP_OPAQUE,
     LIBRARY,

@@ -58,8 +58,8 @@ from statistics import NormalDist
 import mujoco
 import numpy as np
 
+from laserpick.description import dims
 from laserpick.pipeline.types import DepthFrame
-from laserpick.robot import dims
 from laserpick.robot.model import SCOOTER_BODY, depth_intrinsics
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR, GROUP_TRANSPARENT
 from laserpick.settings import SensorSettings, get_settings

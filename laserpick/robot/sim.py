@@ -25,8 +25,8 @@ from typing import Literal
 import mujoco
 import numpy as np
 
+from laserpick.description import dims
 from laserpick.pipeline.trajectory import Trajectory
-from laserpick.robot import dims
 from laserpick.robot.arm_control import CartesianController, TrajectoryTracker
 from laserpick.robot.model import ModelInfo, build_arm_model, build_sim_model
 from laserpick.robot.scenes import Scene
@@ -105,6 +105,7 @@ class Simulation:
         self.model = build_sim_model(scene)
         self.data = mujoco.MjData(self.model)
         self.info = ModelInfo.of(self.model)
+        self._arm_geoms = frozenset(self.info.arm_geoms.tolist())
         self.arm_model = build_arm_model()
         self._cartesian = CartesianController(self.arm_model)
         self.dt = float(self.model.opt.timestep)
@@ -382,6 +383,10 @@ class Simulation:
                     for event in motion.due_events(d.time):
                         self._grip_closed = event.action == "close"
                         self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
+                    guard = motion.traj.guard_force
+                    if guard is not None and (force := self._arm_contact_force()) > guard:
+                        self._halt("failed", f"unexpected contact: {force:.0f} N on the arm")
+                        return
                     if motion.finished(d.time):
                         self._end_motion("done")
                 else:
@@ -453,6 +458,19 @@ class Simulation:
         for i in range(d.ncon):
             c = d.contact[i]
             if c.geom1 in pads or c.geom2 in pads:
+                mujoco.mj_contactForce(self.model, d, i, force)
+                total += abs(force[0])
+        return total
+
+    def _arm_contact_force(self) -> float:
+        """Summed normal force (N) of the contacts on the arm and the gripper: what the UR5's
+        joint-current force estimate or a wrist force sensor would read."""
+        d, arm = self.data, self._arm_geoms
+        total = 0.0
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.geom1 in arm or c.geom2 in arm:
                 mujoco.mj_contactForce(self.model, d, i, force)
                 total += abs(force[0])
         return total

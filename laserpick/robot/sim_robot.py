@@ -8,6 +8,7 @@ from a snapshot of the state, so capturing never blocks the physics.
 from __future__ import annotations
 
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import mujoco
@@ -81,6 +82,18 @@ class SimRobot:
 
     def execute(self, traj: Trajectory) -> MotionHandle:
         return self.sim.execute(traj)
+
+    def wait(self, handle: MotionHandle, timeout: float) -> str:
+        """Real time: wait on the handle. Headless: step the simulation until it ends."""
+        if self.sim.realtime:
+            return handle.wait(timeout)
+        return self.sim.run_until(handle, timeout)
+
+    def sleep(self, seconds: float) -> None:
+        if self.sim.realtime:
+            time.sleep(seconds)
+        else:
+            self.sim.settle(seconds)
 
     def move_tcp(self, T_base_tcp: np.ndarray, timeout: float = 10.0) -> MotionHandle:
         """Cartesian move of the TCP to a pose in `base` (mink IK)."""

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import ur_analytic_ik
 
-from laserpick.robot import dims
+from laserpick.description import dims
 from laserpick.transforms import invert, make_transform, rotz
 
 T_BASE_UR5 = make_transform(rotz(dims.ARM_MOUNT_YAW), dims.ARM_MOUNT_POS)

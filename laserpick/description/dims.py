@@ -50,9 +50,10 @@ UR5_TORQUE_MAX = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
 #: Folded down and back along the scooter's right side, gripper down: out of the depth
 #: cameras' view of the workspace (only right_55 sees part of it) and clear of the basket (rad).
 UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
-#: Raised in front, elbow up, gripper pointing down with the TCP at about (1.40, -0.30, 0.85)
-#: in `base`: the transit pose between home and any grasp above the workspace (rad).
-UR5_READY_Q = np.array([-0.433, -1.705, 1.549, 1.727, 1.571, 1.138])
+#: Raised in front, elbow up, gripper pointing down with the TCP at about (1.50, -0.30, 0.85)
+#: in `base`: the transit pose between home and any grasp above the workspace. Far enough
+#: forward that the elbow clears the right sensor housings by 3 cm (rad).
+UR5_READY_Q = np.array([-0.308, -1.453, 1.299, 1.725, 1.571, 1.263])
 
 # --- Gripper (Robotiq 2F-85-like parallel jaw) ------------------------------------------------
 
