@@ -43,16 +43,14 @@ def _link_capsules() -> tuple[tuple[Segment, ...], ...]:
 #: Capsules (from, to, radius) of each of the six links, in that link's body frame (m).
 LINK_CAPSULES: tuple[tuple[Segment, ...], ...] = _link_capsules()
 
-_FINGER_SPAN = dims.GRIPPER_STROKE / 2 + dims.GRIPPER_PAD_THICKNESS + 0.008  # outer face, open
-#: The gripper in the flange frame (m): its housing, and the open fingers as one capsule
-#: spanning both. Conservative: the hand itself is checked exactly by grasp detection.
+_FINGER_Y = dims.GRIPPER_STROKE / 2 + dims.GRIPPER_PAD_THICKNESS  # plate's inner face, open
+_FINGER_R = 0.015  # covers the plate (24 x 8 mm) and its pad
+_ROOT, _TIP = dims.GRIPPER_BASE_LENGTH, dims.GRIPPER_BASE_LENGTH + dims.GRIPPER_FINGER_LENGTH
+#: The gripper in the flange frame (m): its housing, and each open finger with its pad.
 GRIPPER_CAPSULES: tuple[Segment, ...] = (
-    ((0, 0, 0.02), (0, 0, dims.GRIPPER_BASE_LENGTH - 0.02), dims.GRIPPER_BODY_WIDTH / 2),
-    (
-        (0, 0, dims.GRIPPER_BASE_LENGTH + 0.012),
-        (0, 0, dims.GRIPPER_BASE_LENGTH + dims.GRIPPER_FINGER_LENGTH - 0.012),
-        math.hypot(_FINGER_SPAN, 0.012) - 0.02,
-    ),
+    ((0, 0, 0.02), (0, 0, _ROOT - 0.01), 0.05),
+    ((0, _FINGER_Y, _ROOT + _FINGER_R), (0, _FINGER_Y, _TIP - _FINGER_R), _FINGER_R),
+    ((0, -_FINGER_Y, _ROOT + _FINGER_R), (0, -_FINGER_Y, _TIP - _FINGER_R), _FINGER_R),
 )
 
 
@@ -69,7 +67,9 @@ def _keepout() -> tuple[Box, ...]:
     deck_top = dims.SCOOTER_DECK_HEIGHT
     x_rear = -dims.SCOOTER_REAR_OVERHANG
     half_w = dims.SCOOTER_WIDTH / 2
-    bc, bi = dims.BASKET_CENTER, dims.BASKET_INNER / 2 + dims.BASKET_WALL
+    w = dims.BASKET_WALL + 0.005
+    bx0, by0, bz0 = dims.BASKET_CENTER - dims.BASKET_INNER / 2 - w
+    bx1, by1, bz1 = dims.BASKET_CENTER + dims.BASKET_INNER / 2 + w
     post_x = dims.SENSOR_X - 0.1
     post_y = dims.SENSOR_GROUP_SPACING / 2
     head_lo = dims.SENSOR_LOW_HEIGHT + 0.03  # top of the low sensors' housings
@@ -87,12 +87,12 @@ def _keepout() -> tuple[Box, ...]:
             (dims.TILLER_X - 0.08, -dims.HANDLEBAR_WIDTH / 2 - 0.03, deck_top),
             (dims.TILLER_X + 0.09, dims.HANDLEBAR_WIDTH / 2 + 0.03, dims.HANDLEBAR_HEIGHT + 0.04),
         ),
-        # The basket: its walls and floor (the arm drops from above its open top).
-        Box(
-            "basket",
-            (bc[0] - bi[0], bc[1] - bi[1], bc[2] - bi[2] - 0.01),
-            (bc[0] + bi[0], bc[1] + bi[1], bc[2] + bi[2]),
-        ),
+        # The basket: its floor and four walls, open at the top for a drop.
+        Box("basket_floor", (bx0, by0, bz0), (bx1, by1, bz0 + w)),
+        Box("basket_front", (bx1 - w, by0, bz0), (bx1, by1, bz1)),
+        Box("basket_back", (bx0, by0, bz0), (bx0 + w, by1, bz1)),
+        Box("basket_left", (bx0, by1 - w, bz0), (bx1, by1, bz1)),
+        Box("basket_right", (bx0, by0, bz0), (bx1, by0 + w, bz1)),
         # The sensor posts: thin poles, the cameras' heads near their tops, and the projector.
         Box(
             "pole_left",

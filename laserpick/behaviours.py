@@ -1,0 +1,264 @@
+"""Executed behaviours on any `Robot`: pick, drop in the basket, place at a mark, go ready.
+
+Each checks its preconditions before it moves and its postconditions after (EL-E, 000
+section 4.6; the re-grip of 002), and ends in one `Outcome`: done, or a typed `Failure` with
+a sentence the user can read. A failed behaviour leaves the arm at rest, and never holding
+the gripper half closed on nothing.
+
+The pick (004 section 7.4): try the grasps in score order and execute the first that plans;
+move to the pre-grasp; approach in a straight, guarded line (an unexpected contact stops the
+arm, which then backs off); close; lift 2 cm and close again; lift 10 cm; check the hold.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import logging
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import CollisionChecker, thin
+from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, plan_pick, timed
+from laserpick.pipeline.trajectory import Trajectory
+from laserpick.pipeline.types import Failure, Grasp
+from laserpick.robot.interface import Robot
+from laserpick.settings import Settings, get_settings
+from laserpick.transforms import roty, rotz
+
+log = logging.getLogger(__name__)
+
+#: Time (s) the gripper gets to close or open: the full 85 mm stroke at 0.15 m/s, plus margin.
+GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
+#: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
+MOTION_SLACK = 3.0
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage."""
+
+    failure: Failure | None = None
+    grasp: Grasp | None = None
+    attempts: int = 0
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
+
+
+@dataclass
+class Held:
+    """What the hand holds after a pick: the grasp, its height above the support surface (m)
+    (for placing, 004 section 7.3), the object's points in the TCP frame (m, thinned: the
+    planner carries them with the hand) and the obstacles around it."""
+
+    grasp: Grasp
+    height_above_support: float
+    points_tcp: np.ndarray
+    surroundings: CollisionChecker
+
+
+@functools.cache
+def drop_candidates() -> tuple[np.ndarray, ...]:
+    """Joint configurations that put the TCP over the basket's opening, the arm clear of the
+    scooter (rad). Computed once: the basket is fixed to the scooter."""
+    centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
+    rim = centre[2] + inner[2] / 2
+    free = CollisionChecker(np.zeros((0, 3)))
+    out = []
+    for dx, dy, dz, yaw, tilt in itertools.product(
+        np.linspace(-0.3, 0.3, 3) * inner[0],
+        np.linspace(-0.3, 0.3, 3) * inner[1],
+        (0.06, 0.10, 0.14),
+        np.radians(np.arange(0, 180, 30)),
+        np.radians((0, 15, 30)),
+    ):
+        T = np.eye(4)
+        T[:3, :3] = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down
+        T[:3, 3] = [centre[0] + dx, centre[1] + dy, rim + dz]
+        Q = ik_tcp(T, dims.UR5_READY_Q)
+        out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
+    return tuple(out)
+
+
+class Behaviours:
+    """The robot's behaviours, run one at a time from the caller's thread.
+
+    progress: called with a short sentence at each step, for the console and logs.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        settings: Settings | None = None,
+        rng: np.random.Generator | None = None,
+        progress: Callable[[str], None] | None = None,
+    ) -> None:
+        self.robot = robot
+        self.settings = settings or get_settings()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.progress = progress or (lambda msg: log.info(msg))
+        self.held: Held | None = None
+
+    # --- motion primitives -------------------------------------------------------------------
+
+    def _run(self, traj: Trajectory, what: str) -> Failure | None:
+        handle = self.robot.execute(traj)
+        status = self.robot.wait(handle, traj.duration + MOTION_SLACK)
+        if status == "done":
+            return None
+        if status == "running":
+            self.robot.stop()
+            self.robot.reset_stop()
+            return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
+        return Failure("execute", f"The arm stopped while {what}: {handle.message}.")
+
+    def _q(self) -> np.ndarray:
+        return self.robot.joint_state().q
+
+    def go_to(self, q_goal: np.ndarray, checker: CollisionChecker, what: str, **kw) -> Outcome:
+        """A collision-free joint move to q_goal (6,) rad."""
+        path = joint_path(self._q(), q_goal, checker, self.rng, self.settings.motion, **kw)
+        if path is None:
+            return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
+        return Outcome(self._run(timed(path, self.settings.motion), what))
+
+    def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
+        """To the ready pose, raised in front with the gripper down."""
+        return self.go_to(
+            dims.UR5_READY_Q, checker or CollisionChecker(np.zeros((0, 3))), "going to ready"
+        )
+
+    # --- pick ------------------------------------------------------------------------------
+
+    def pick(self, grasps: GraspSet, order: Sequence[Grasp] | None = None) -> Outcome:
+        """Pick with the first grasp of `order` (default: all, in score order) that plans."""
+        s = self.settings.motion
+        if self.robot.gripper_state().holding:
+            return Outcome(Failure("precondition", "The hand is already holding something."))
+        order = list(order) if order is not None else grasps.ordered()
+        t0 = time.perf_counter()
+        plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
+        attempts = 0
+        q_now = self._q()
+        # From a stowed arm, go through the ready pose: a known path out of the cameras' way.
+        via = None if np.max(np.abs(q_now - dims.UR5_READY_Q)) < 0.05 else dims.UR5_READY_Q
+        for grasp in order:
+            attempts += 1
+            assert grasp.ik is not None
+            plan = plan_pick(
+                q_now, grasp.ik, grasps.world, grasps.surroundings, self.rng, s, via=via
+            )
+            if not isinstance(plan, Failure):
+                break
+        timings = {"plan": time.perf_counter() - t0}
+        if isinstance(plan, Failure):
+            msg = f"None of the {attempts} grasps could be planned ({plan.message})"
+            return Outcome(Failure("ik_plan", msg), attempts=attempts, timings=timings)
+        self.progress(f"Grasp {attempts} of {len(order)} planned; moving to it.")
+        self.robot.gripper(False)
+        failure = self._run(plan.transit, "moving to the grasp")
+        if failure:
+            return Outcome(failure, grasp, attempts, timings)
+        guarded = Trajectory(
+            plan.approach.times, plan.approach.q, plan.approach.gripper, guard_force=s.guard_force
+        )
+        failure = self._run(guarded, "approaching the object")
+        if failure:
+            self._back_off()
+            msg = "The hand touched something on its way in, stopped and backed off."
+            return Outcome(Failure("execute", msg), grasp, attempts, timings)
+        self.progress("Closing the gripper.")
+        self.robot.gripper(True)
+        self.robot.sleep(GRIPPER_TIME)
+        if not self._gripping():
+            self._release_and_retreat(plan)
+            return Outcome(
+                Failure("execute", "The gripper closed on nothing."), grasp, attempts, timings
+            )
+        # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
+        failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
+        self.robot.gripper(True)
+        self.robot.sleep(0.3)
+        failure = failure or self._run(plan.lift, "lifting")
+        self.robot.sleep(0.3)
+        if failure is None and not self.robot.gripper_state().holding:
+            failure = Failure("execute", "The object slipped out of the hand while lifting.")
+        if failure:
+            self.robot.gripper(False)
+            self.robot.sleep(GRIPPER_TIME)
+            return Outcome(failure, grasp, attempts, timings)
+        support = grasps.target[:, 2].min()
+        pts = grasps.target[thin(grasps.target, 0.02)]
+        pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
+        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
+        self.progress("Holding the object.")
+        return Outcome(None, grasp, attempts, timings)
+
+    def _gripping(self) -> bool:
+        state = self.robot.gripper_state()
+        return state.closed and state.width > dims.GRIPPER_EMPTY_GAP
+
+    def _back_off(self) -> None:
+        """After a stopped approach: straight back along the approach axis."""
+        q = self._q()
+        T = tcp_pose(q)
+        T_back = T.copy()
+        T_back[:3, 3] -= self.settings.motion.backoff * T[:3, 2]
+        path = cartesian_line(q, T_back, self.settings.motion.cartesian_step)
+        if path is not None:
+            self._run(timed(path, self.settings.motion, tcp_speed=0.05), "backing off")
+
+    def _release_and_retreat(self, plan: PickPlan) -> None:
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        back = cartesian_line(self._q(), tcp_pose(plan.approach.q[0]), 0.01)
+        if back is not None:
+            self._run(timed(back, self.settings.motion, tcp_speed=0.1), "retreating")
+
+    # --- drop and place -------------------------------------------------------------------
+
+    def drop_configuration(
+        self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
+    ) -> np.ndarray | None:
+        """A clear joint configuration with the TCP over the basket's opening, the gripper
+        pointing down or tilted up to 30 deg, 10-16 cm above the rim; nearest q_ref wins.
+
+        The basket sits close beside the arm's base, between the tiller, the sensor posts
+        and the projector, so few postures reach over it: they are searched, not assumed.
+        """
+        best = None
+        for q in drop_candidates():
+            d = float(np.max(np.abs(q - q_ref)))
+            if (best is None or d < best[0]) and checker.clearance_ok(q, payload=payload)[0]:
+                best = (d, q)
+        return None if best is None else best[1]
+
+    def drop_in_basket(self) -> Outcome:
+        """Carry what the hand holds to the basket, release it, and return to ready."""
+        if self.held is None or not self.robot.gripper_state().holding:
+            self.held = None
+            return Outcome(Failure("precondition", "The hand is not holding anything."))
+        held = self.held
+        q_drop = self.drop_configuration(self._q(), held.surroundings, held.points_tcp)
+        if q_drop is None:
+            return Outcome(Failure("ik_plan", "The arm cannot reach over the basket."))
+        self.progress("Carrying the object to the basket.")
+        out = self.go_to(
+            q_drop, held.surroundings, "carrying to the basket", payload=held.points_tcp
+        )
+        if not out.ok:
+            return out
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        self.held = None
+        self.progress("Released into the basket.")
+        return self.go_ready(held.surroundings)

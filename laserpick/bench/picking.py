@@ -1,0 +1,162 @@
+"""One scripted pick-and-drop trial, as 004 section 8.1 ran them: the operator marks an object
+with the laser, the robot perceives, finds grasps, picks and drops the object in the basket,
+and the referee scores it. Shared by the picking benchmarks.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from laserpick.behaviours import Behaviours
+from laserpick.bench.operator import Referee, mark_and_capture
+from laserpick.description import dims
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.grasping import GraspSet, Strategy, find_grasps
+from laserpick.pipeline.perceive import perceive
+from laserpick.pipeline.types import Failure, Grasp
+from laserpick.robot.sim_robot import SimRobot
+
+#: The columns of the failure table, in 004's order (Table 1), plus "precondition".
+FAILURE_KINDS = ("detect_laser", "detect_grasp", "ik_plan", "wrong_object", "execute")
+
+
+@dataclass
+class Attempt:
+    """The record of one marked object."""
+
+    instance: str
+    model: str
+    detected: bool = False  #: the grasp chosen was on the marked object
+    success: bool = False  #: the marked object ended up in the basket
+    failure: str | None = None  #: a FailureKind, when it did not succeed
+    message: str = ""
+    timings: dict[str, float] = field(default_factory=dict)  #: s per pipeline stage
+
+    @property
+    def decide_time(self) -> float:
+        """Grasp detection, filter, selection and planning (s): 004's 4.7 + 1.6 + 2.9 s."""
+        return sum(self.timings.get(k, 0.0) for k in ("detect", "filter", "select", "plan"))
+
+
+def stow(robot: SimRobot, behaviours: Behaviours) -> None:
+    """Empty the hand and fold the arm out of the cameras' view for the next capture."""
+    if robot.gripper_state().closed:
+        robot.gripper(False)
+        robot.sleep(1.0)
+    behaviours.held = None
+    out = behaviours.go_to(dims.UR5_HOME_Q, CollisionChecker(np.zeros((0, 3))), "stowing")
+    if not out.ok:
+        raise RuntimeError(f"the arm could not stow: {out.failure}")
+
+
+def pick_and_drop(
+    robot: SimRobot,
+    behaviours: Behaviours,
+    referee: Referee,
+    instance: str,
+    rng: np.random.Generator,
+    *,
+    strategy: Strategy = "gpd",
+    choose: str = "auto",
+) -> Attempt:
+    """Mark `instance`, pick it and drop it in the basket; the arm starts and ends stowed.
+
+    choose: "auto" tries the grasps in score order (004 section 7.4); "manual" plays a user
+    who steps through the clusters to the first whose best grasp is on the marked object
+    (004 section 7.2), and tries that cluster's grasps.
+    """
+    placements = robot.sim.scene.placements  # type: ignore[union-attr]
+    names = [p.instance for p in placements]
+    model = next(p.model.name for p in placements if p.instance == instance)
+    rec = Attempt(instance, model)
+    aim = referee.aim_point(instance)
+    if aim is None:
+        rec.failure, rec.message = "detect_laser", "no camera sees the object"
+        return rec
+    frames = mark_and_capture(robot, aim, rng)
+    perception = perceive(frames)
+    rec.timings.update(perception.timings)
+    if not perception.ok:
+        assert perception.failure is not None
+        rec.failure, rec.message = perception.failure.kind, perception.failure.message
+        return rec
+    found = find_grasps(
+        perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q, strategy=strategy, rng=rng
+    )
+    if isinstance(found, Failure):
+        rec.failure, rec.message = found.kind, found.message
+        return rec
+    rec.timings.update(found.timings)
+    order = choose_order(found, choose, referee, instance)
+    outcome = behaviours.pick(found, order)
+    rec.timings.update(outcome.timings)
+    if outcome.grasp is not None:
+        rec.detected = referee.grasped_object(outcome.grasp, names) == instance
+    dropped = behaviours.drop_in_basket() if outcome.ok else None
+    robot.sleep(1.0)
+    rec.success = rec.detected and referee.in_basket(instance)
+    if rec.success:
+        return rec
+    if outcome.grasp is not None and not rec.detected:
+        rec.failure, rec.message = "wrong_object", "the chosen grasp was on another object"
+    elif outcome.failure is not None:
+        rec.failure, rec.message = outcome.failure.kind, outcome.failure.message
+    elif dropped is not None and dropped.failure is not None:
+        rec.failure, rec.message = dropped.failure.kind, dropped.failure.message
+    else:
+        rec.failure, rec.message = "execute", "the object did not land in the basket"
+    return rec
+
+
+def choose_order(found: GraspSet, choose: str, referee: Referee, instance: str) -> list[Grasp]:
+    """The grasps to try, in order, for automatic or (scripted) manual selection."""
+    if choose == "auto":
+        return found.ordered()
+    names = [p.instance for p in referee.robot.sim.scene.placements]  # type: ignore[union-attr]
+    grasps, clusters = found.clusters.grasps, found.clusters.clusters
+    for members in clusters:  # the user toggles through clusters, best first
+        if referee.grasped_object(grasps[members[0]], names) == instance:
+            return [grasps[i] for i in members]
+    return found.ordered()  # no cluster on the target: the user accepts the system's choice
+
+
+def run_scene(
+    robot: SimRobot,
+    instances: list[str],
+    rng: np.random.Generator,
+    *,
+    strategy: Strategy = "gpd",
+    choose: str = "auto",
+    log=print,
+) -> list[Attempt]:
+    """Pick-and-drop each instance in turn (in the given order) on a running scene."""
+    behaviours = Behaviours(robot, rng=rng, progress=lambda _msg: None)
+    referee = Referee(robot)
+    out = []
+    for name in instances:
+        t0 = time.perf_counter()
+        rec = pick_and_drop(robot, behaviours, referee, name, rng, strategy=strategy, choose=choose)
+        stow(robot, behaviours)
+        verdict = "ok" if rec.success else f"{rec.failure}: {rec.message}"
+        log(
+            f"  {name:<22} {verdict}  (decide {rec.decide_time * 1000:.0f} ms,"
+            f" wall {time.perf_counter() - t0:.1f} s)"
+        )
+        out.append(rec)
+    return out
+
+
+def failure_table(attempts: list[Attempt]) -> str:
+    """004's Table 1 layout: per object, attempts, successes and the failures by kind."""
+    models = sorted({a.model for a in attempts})
+    head = f"{'object':<16}{'tries':>6}{'ok':>5}" + "".join(f"{k:>14}" for k in FAILURE_KINDS)
+    lines = [head, "-" * len(head)]
+    for m in [*models, "all"]:
+        rows = [a for a in attempts if m in ("all", a.model)]
+        counts = [sum(a.failure == k for a in rows) for k in FAILURE_KINDS]
+        ok = sum(a.success for a in rows)
+        lines.append(f"{m:<16}{len(rows):>6}{ok:>5}" + "".join(f"{c:>14}" for c in counts))
+    return "\n".join(lines)

@@ -1,0 +1,212 @@
+"""Arm collision checks for planning (paper 004 section 7): the UR5 and its gripper as chains
+of spheres, tested against the fused cloud (a KD-tree of voxel-thinned points), the keep-out
+boxes around the scooter and its rider, and the floor.
+
+Spheres cover the capsules of `description/collision.py` (a capsule of radius r as spheres at
+most r apart, each grown to cover the waist between neighbours). Frames: `base`, metres.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from laserpick.description.collision import (
+    FLOOR_CLEARANCE,
+    GRIPPER_CAPSULES,
+    KEEPOUT_BOXES,
+    LINK_CAPSULES,
+    Segment,
+    body_frames,
+)
+from laserpick.description.dims import ARM_MOUNT_POS
+from laserpick.description.kinematics import T_FLANGE_TCP
+
+
+@dataclass(frozen=True)
+class SphereModel:
+    """Sphere centres in their body frames and radii (m). body: 0..5 the links, 6 the flange."""
+
+    body: np.ndarray  #: (S,) int
+    centre: np.ndarray  #: (S, 3) in the body's frame
+    radius: np.ndarray  #: (S,)
+    hand: np.ndarray  #: (S,) bool: part of the gripper
+
+
+def _spheres(segment: Segment) -> tuple[np.ndarray, float]:
+    a, b, r = np.asarray(segment[0], float), np.asarray(segment[1], float), segment[2]
+    n = max(2, math.ceil(np.linalg.norm(b - a) / r) + 1)
+    spacing = np.linalg.norm(b - a) / (n - 1)
+    return np.linspace(a, b, n), math.hypot(r, spacing / 2)
+
+
+def sphere_model() -> SphereModel:
+    """The arm's spheres, built from the shared capsule table."""
+    body, centre, radius, hand = [], [], [], []
+    parts = [(i, seg, False) for i, segs in enumerate(LINK_CAPSULES) for seg in segs]
+    parts += [(6, seg, True) for seg in GRIPPER_CAPSULES]
+    for i, seg, is_hand in parts:
+        c, r = _spheres(seg)
+        body += [i] * len(c)
+        centre.append(c)
+        radius += [r] * len(c)
+        hand += [is_hand] * len(c)
+    return SphereModel(
+        np.array(body), np.vstack(centre), np.array(radius), np.array(hand, dtype=bool)
+    )
+
+
+SPHERES = sphere_model()
+_LO = np.array([b.lo for b in KEEPOUT_BOXES])
+_HI = np.array([b.hi for b in KEEPOUT_BOXES])
+
+
+def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarray:
+    """World (`base`) centres (B, S, 3) of the spheres for body frames (B, 7, 4, 4)."""
+    F = frames[:, model.body]  # (B, S, 4, 4)
+    return np.einsum("bsij,sj->bsi", F[..., :3, :3], model.centre) + F[..., :3, 3]
+
+
+#: The arm's reach from its shoulder, with the open hand (m): obstacles beyond cannot matter.
+REACH = 1.15
+_SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + 0.089])
+#: Radius (m) of each point of a held object's cloud, as carried by the hand.
+PAYLOAD_POINT_RADIUS = 0.01
+#: A held object is checked against the arm's bodies up to this one (3: wrist 1).
+PAYLOAD_CLEAR_OF_BODY = 3
+
+
+def thin(points: np.ndarray, voxel: float) -> np.ndarray:
+    """Mask of one point (the first) per occupied voxel of edge `voxel` (m)."""
+    keep = np.zeros(len(points), bool)
+    if len(points) == 0:
+        return keep
+    k = np.floor(points / voxel).astype(np.int64)
+    k -= k.min(axis=0)
+    span = k.max(axis=0) + 1
+    key = (k[:, 0] * span[1] + k[:, 1]) * span[2] + k[:, 2]
+    _, first = np.unique(key, return_index=True)
+    keep[first] = True
+    return keep
+
+
+def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.ndarray:
+    """Mask (N,) of the points that are not the arm itself at joint angles q (6,): a real
+    robot's self filter, so the planner does not take its own arm for an obstacle.
+
+    padding (m) grows every sphere, for sensor noise and the capture's timing.
+    """
+    centres = sphere_centres(body_frames(q))[0]
+    keep = np.ones(len(points), bool)
+    if len(points) == 0:
+        return keep
+    tree = cKDTree(np.asarray(points, float))
+    for c, r in zip(centres, SPHERES.radius + padding, strict=True):
+        keep[tree.query_ball_point(c, r)] = False
+    return keep
+
+
+class CollisionChecker:
+    """Is the arm clear of the cloud, the scooter and the floor at these joint angles?
+
+    obstacles: (N, 3) points in `base` (m). Points beyond the arm's reach are dropped, the
+    rest thinned to one per `voxel` (m) for the KD-tree. margin: clearance (m) kept from
+    every obstacle on top of the spheres' radii. q_self: the arm's joint angles when the
+    points were captured, to filter out the arm's own points.
+    """
+
+    def __init__(
+        self,
+        obstacles: np.ndarray,
+        *,
+        margin: float = 0.01,
+        voxel: float = 0.01,
+        q_self: np.ndarray | None = None,
+    ):
+        pts = np.asarray(obstacles, float).reshape(-1, 3)
+        d = pts - _SHOULDER
+        pts = pts[np.all(np.isfinite(pts), axis=1) & (np.einsum("ij,ij->i", d, d) < REACH**2)]
+        if voxel > 0:
+            pts = pts[thin(pts, voxel)]
+        if q_self is not None:
+            pts = pts[self_filter(pts, q_self)]
+        self.points = pts
+        self.tree = cKDTree(pts) if len(pts) else None
+        self.margin = margin
+
+    def clearance_ok(
+        self, Q: np.ndarray, *, hand: bool = True, payload: np.ndarray | None = None
+    ) -> np.ndarray:
+        """(B,) True where configuration Q[b] (B, 6) (rad) collides with nothing.
+
+        hand: include the gripper's spheres (grasp detection already checked the hand at the
+        grasp itself). payload: a held object's points (P, 3) in the TCP frame (m), each a
+        sphere of PAYLOAD_POINT_RADIUS carried with the hand.
+        """
+        Q = np.atleast_2d(np.asarray(Q, float))
+        frames = body_frames(Q)
+        centres = sphere_centres(frames)
+        radius = SPHERES.radius
+        if not hand:
+            centres, radius = centres[:, ~SPHERES.hand], radius[~SPHERES.hand]
+        clear = np.ones(len(Q), bool)
+        if payload is not None and len(payload):
+            T = frames[:, 6] @ T_FLANGE_TCP
+            held = np.einsum("bij,pj->bpi", T[:, :3, :3], payload) + T[:, None, :3, 3]
+            # The held object must also keep off the arm's own upper links: the wrist links
+            # next to the hand are expected near it.
+            upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
+            links = sphere_centres(frames)[:, upper]
+            gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
+            reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + self.margin
+            clear &= ~(gap < reach).any(axis=(1, 2))
+            centres = np.concatenate([centres, held], axis=1)
+            radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
+        return clear & ~self._hits(centres, radius).any(axis=1)
+
+    def _hits(self, centres: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
+        B, S, _ = centres.shape
+        reach = radius[None, :] + self.margin
+        hit = centres[..., 2] < radius + FLOOR_CLEARANCE
+        # Distance from each centre to each box (B, S, K).
+        gap = np.maximum(_LO - centres[..., None, :], centres[..., None, :] - _HI)
+        d_box = np.linalg.norm(np.maximum(gap, 0.0), axis=-1)
+        hit |= (d_box < reach[..., None]).any(axis=-1)
+        if self.tree is not None:
+            flat = centres.reshape(-1, 3)
+            bound = float(radius.max() + self.margin)
+            d, _ = self.tree.query(flat, k=1, distance_upper_bound=bound)
+            hit |= d.reshape(B, S) < reach
+        return hit
+
+    def what_hits(self, q: np.ndarray, *, hand: bool = True) -> list[str]:
+        """Names of what configuration q (6,) touches: "cloud", "floor", or a keep-out box."""
+        centres = sphere_centres(body_frames(q))[0]
+        radius = SPHERES.radius
+        if not hand:
+            centres, radius = centres[~SPHERES.hand], radius[~SPHERES.hand]
+        reach = radius + self.margin
+        names = []
+        if np.any(centres[:, 2] < radius + FLOOR_CLEARANCE):
+            names.append("floor")
+        gap = np.maximum(_LO - centres[:, None, :], centres[:, None, :] - _HI)
+        d_box = np.linalg.norm(np.maximum(gap, 0.0), axis=-1)
+        names += [b.name for k, b in enumerate(KEEPOUT_BOXES) if np.any(d_box[:, k] < reach)]
+        if self.tree is not None:
+            d, _ = self.tree.query(centres, k=1, distance_upper_bound=float(reach.max()))
+            if np.any(d < reach):
+                names.append("cloud")
+        return names
+
+    def segment_ok(
+        self, qa: np.ndarray, qb: np.ndarray, *, step: float = 0.03, **kw: object
+    ) -> bool:
+        """Whether the straight joint-space segment qa -> qb is clear, checked every `step`
+        rad of the largest joint motion (0.03 rad moves a 0.9 m reach by under 3 cm)."""
+        n = max(2, math.ceil(float(np.max(np.abs(qb - qa))) / step) + 1)
+        Q = np.linspace(qa, qb, n)
+        return bool(self.clearance_ok(Q, **kw).all())  # type: ignore[arg-type]

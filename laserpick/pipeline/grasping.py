@@ -1,0 +1,151 @@
+"""From a perceived target to ordered, reachable grasps (004 sections 6.2 and 7), by one of
+three strategies:
+
+- "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004).
+- "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
+- "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
+  takes once its base has centred the object (003 section IV).
+
+Every candidate then goes through the reachability filter, is scored with 004's objective and
+clustered by position. Each stage is timed. Frames: `base`, metres, radians.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from laserpick.description.dims import ARM_MOUNT_POS
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.overhead import overhead_grasp
+from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.reach import reachable
+from laserpick.pipeline.selection import GraspClusters, group, score
+from laserpick.pipeline.types import Failure, Grasp
+from laserpick.settings import Settings, get_settings
+
+Strategy = Literal["gpd", "overhead", "vertical"]
+STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
+
+
+@dataclass(frozen=True)
+class GraspSet:
+    """The grasps for one target.
+
+    clusters: the reachable grasps, scored and clustered, best first. rejected: the
+    candidates the filter dropped, each with its `ik_failure`. world: collision model of the
+    whole cloud; surroundings: of the cloud without the target (the hand may touch it).
+    timings: seconds per stage: "detect", "filter", "select".
+    """
+
+    clusters: GraspClusters
+    rejected: tuple[Grasp, ...]
+    world: CollisionChecker
+    surroundings: CollisionChecker
+    target: np.ndarray
+    strategy: Strategy
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def ordered(self) -> list[Grasp]:
+        """Every reachable grasp, best cluster first and best first within each (004's order
+        of trying them)."""
+        g = self.clusters.grasps
+        return [g[i] for members in self.clusters.clusters for i in members]
+
+
+def vertical_grasp(target: np.ndarray, settings: Settings) -> Grasp | Failure:
+    """A top-down grasp at the centroid, closing across the narrow side, 2 cm below the top."""
+    centre = target.mean(axis=0)
+    xy = target[:, :2] - centre[:2]
+    _, vecs = np.linalg.eigh(np.cov(xy.T) if len(xy) > 2 else np.eye(2))
+    closing = np.append(vecs[:, 0], 0.0)
+    across = xy @ vecs[:, 0]
+    width = float(across.max() - across.min())
+    if width > settings.grasp.width_max:
+        return Failure("detect_grasp", "The object is wider than the gripper opens.")
+    approach = np.array([0.0, 0.0, -1.0])
+    pose = np.eye(4)
+    pose[:3, 0] = np.cross(closing, approach)
+    pose[:3, 1] = closing
+    pose[:3, 2] = approach
+    top = float(target[:, 2].max())
+    pose[:3, 3] = [centre[0], centre[1], top - 0.02 + settings.grasp.pad_depth / 2]
+    return Grasp(pose=pose, width=width)
+
+
+def candidates(
+    perception: Perception, strategy: Strategy, settings: Settings, rng: np.random.Generator
+) -> list[Grasp] | Failure:
+    """Raw grasp candidates on the perceived target."""
+    cloud, seg = perception.cloud, perception.segmentation
+    assert seg is not None
+    target = cloud.points[seg.indices].astype(np.float64)
+    if strategy == "gpd":
+        return detect_grasps(
+            target, cloud.normals[seg.indices], cloud.points, settings.grasp, rng=rng
+        )
+    if strategy == "overhead":
+        support = seg.surface.height if seg.surface is not None else float(target[:, 2].min())
+        g = overhead_grasp(target, cloud.points, support, ARM_MOUNT_POS[:2], settings.grasp)
+    else:
+        g = vertical_grasp(target, settings)
+    return g if isinstance(g, Failure) else [g]
+
+
+def find_grasps(
+    perception: Perception,
+    q_ref: np.ndarray,
+    *,
+    q_capture: np.ndarray | None = None,
+    strategy: Strategy = "gpd",
+    settings: Settings | None = None,
+    rng: np.random.Generator | None = None,
+) -> GraspSet | Failure:
+    """Detect, filter, score and cluster grasps on the target of a successful perception.
+
+    q_ref (6,) rad: the arm's configuration when the grasp motion starts (Cj's origin and the
+    IK branch preference). q_capture (6,) rad: the arm's joint angles when the frames were
+    captured; the arm's own points are then left out of the obstacles.
+    """
+    s = settings or get_settings()
+    if not perception.ok or perception.segmentation is None or perception.mark is None:
+        return perception.failure or Failure("detect_laser", "There is no target to grasp.")
+    if strategy not in STRATEGIES:
+        raise ValueError(f"unknown grasp strategy {strategy!r}; use one of {STRATEGIES}")
+    rng = rng if rng is not None else np.random.default_rng(0)
+    timings: dict[str, float] = {}
+    cloud, seg = perception.cloud, perception.segmentation
+    target = cloud.points[seg.indices].astype(np.float64)
+
+    t0 = time.perf_counter()
+    found = candidates(perception, strategy, s, rng)
+    timings["detect"] = time.perf_counter() - t0
+    if isinstance(found, Failure):
+        return found
+    if not found:
+        return Failure("detect_grasp", "No grasp fits this object.")
+
+    t0 = time.perf_counter()
+    margin = s.motion.clearance
+    others = np.ones(len(cloud), bool)
+    others[seg.indices] = False
+    world = CollisionChecker(cloud.points, margin=margin, q_self=q_capture)
+    surroundings = CollisionChecker(cloud.points[others], margin=margin, q_self=q_capture)
+    checked = reachable(found, world, q_ref, s.motion.approach_distance)
+    timings["filter"] = time.perf_counter() - t0
+    ok = [g for g in checked if g.ik is not None]
+    rejected = tuple(g for g in checked if g.ik is None)
+    if not ok:
+        reason = rejected[0].ik_failure if rejected else "no grasp"
+        return Failure("ik_plan", f"The arm cannot take any of {len(found)} grasps ({reason}).")
+
+    t0 = time.perf_counter()
+    mark = perception.mark.point
+    scored = [score(g, q_now=q_ref, sample=target, mark=mark, settings=s.grasp) for g in ok]
+    clusters = group(scored, s.grasp)
+    timings["select"] = time.perf_counter() - t0
+    return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings)

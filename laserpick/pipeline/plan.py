@@ -1,0 +1,244 @@
+"""Motion planning for picks and places (paper 004 section 7.4).
+
+Straight lines first: a straight joint-space move when it is clear, and straight Cartesian
+lines for the approach and the lift. When a joint-space move collides, RRT-Connect (Kuffner
+and LaValle 2000) searches around the obstacle, and the path is shortened by random
+shortcuts. Every path is checked against a `CollisionChecker`, then time-parametrized within
+the joint speed, joint acceleration and TCP speed limits of `MotionSettings`.
+
+Frames: TCP poses in `base` (m); joint angles in rad.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.timing import time_parametrize
+from laserpick.pipeline.trajectory import Trajectory
+from laserpick.pipeline.types import Failure
+from laserpick.settings import MotionSettings, get_settings
+
+#: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
+#: step means the IK jumped branches (a singularity), so the line is not followed.
+CARTESIAN_JUMP = 0.25
+
+
+def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
+    """Pose a fraction s of the way from Ta to Tb: linear in position, slerp in rotation."""
+    from scipy.spatial.transform import Rotation, Slerp
+
+    rots = Rotation.from_matrix(np.stack([Ta[:3, :3], Tb[:3, :3]]))
+    T = np.eye(4)
+    T[:3, :3] = Slerp([0.0, 1.0], rots)(s).as_matrix()
+    T[:3, 3] = (1 - s) * Ta[:3, 3] + s * Tb[:3, 3]
+    return T
+
+
+def cartesian_line(
+    q_start: np.ndarray, T_goal: np.ndarray, step: float = 0.01
+) -> np.ndarray | None:
+    """Joint waypoints (K, 6) moving the TCP in a straight line from where q_start (6,) puts
+    it to T_goal, every `step` m; None where IK fails or jumps branches on the way."""
+    T_start = tcp_pose(q_start)
+    dist = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
+    n = max(2, math.ceil(dist / step) + 1)
+    path = [np.asarray(q_start, float)]
+    for s in np.linspace(0.0, 1.0, n)[1:]:
+        sols = ik_tcp(_lerp_pose(T_start, T_goal, float(s)), path[-1])
+        if len(sols) == 0 or np.max(np.abs(sols[0] - path[-1])) > CARTESIAN_JUMP:
+            return None
+        path.append(sols[0])
+    return np.array(path)
+
+
+def shortcut(
+    path: np.ndarray, checker: CollisionChecker, rng: np.random.Generator, tries: int = 60, **kw
+) -> np.ndarray:
+    """Shorten a joint path by joining random pairs of its points where the join is clear."""
+    path = [np.asarray(q) for q in path]
+    for _ in range(tries):
+        if len(path) < 3:
+            break
+        i, j = sorted(rng.choice(len(path), size=2, replace=False))
+        if j - i < 2:
+            continue
+        if checker.segment_ok(path[i], path[j], **kw):
+            path = path[: i + 1] + path[j:]
+    return np.array(path)
+
+
+def rrt_connect(
+    q_start: np.ndarray,
+    q_goal: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    *,
+    step: float = 0.3,
+    max_samples: int = 2000,
+    **kw,
+) -> np.ndarray | None:
+    """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
+
+    Two trees grow toward random samples within the joint limits and toward each other, in
+    steps of at most `step` rad (largest joint); each new edge is collision-checked.
+    """
+    lo = np.maximum(dims.UR5_Q_MIN, np.minimum(q_start, q_goal) - math.pi)
+    hi = np.minimum(dims.UR5_Q_MAX, np.maximum(q_start, q_goal) + math.pi)
+    trees = [([np.asarray(q_start, float)], [-1]), ([np.asarray(q_goal, float)], [-1])]
+
+    def extend(tree, target: np.ndarray) -> tuple[str, int]:
+        nodes, parents = tree
+        near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
+        delta = target - nodes[near]
+        span = float(np.max(np.abs(delta)))
+        reached = span <= step
+        q_new = target if reached else nodes[near] + delta * (step / span)
+        if not checker.segment_ok(nodes[near], q_new, **kw):
+            return "trapped", near
+        nodes.append(q_new)
+        parents.append(near)
+        return ("reached" if reached else "advanced"), len(nodes) - 1
+
+    def branch(tree, index: int) -> list[np.ndarray]:
+        nodes, parents = tree
+        out = []
+        while index >= 0:
+            out.append(nodes[index])
+            index = parents[index]
+        return out
+
+    for _ in range(max_samples):
+        q_rand = rng.uniform(lo, hi)
+        status, a = extend(trees[0], q_rand)
+        if status != "trapped":
+            q_new = trees[0][0][a]
+            while True:  # connect: the other tree steps toward q_new until blocked or there
+                status, b = extend(trees[1], q_new)
+                if status != "advanced":
+                    break
+            if status == "reached":
+                half_a, half_b = branch(trees[0], a), branch(trees[1], b)
+                path = half_a[::-1] + half_b[1:]
+                if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
+                    path = path[::-1]
+                return np.array(path)
+        trees.reverse()
+    return None
+
+
+def joint_path(
+    q_start: np.ndarray,
+    q_goal: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    **kw,
+) -> np.ndarray | None:
+    """A clear joint path: the straight one if clear, else RRT-Connect, shortened."""
+    if checker.segment_ok(q_start, q_goal, **kw):
+        return np.array([q_start, q_goal], float)
+    path = rrt_connect(
+        q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
+    )
+    return None if path is None else shortcut(path, checker, rng, **kw)
+
+
+def timed(
+    path: np.ndarray,
+    s: MotionSettings,
+    *,
+    tcp_speed: float | None = None,
+    gripper: tuple[tuple[int, str], ...] = (),
+) -> Trajectory:
+    """Time-parametrize a joint path within the motion limits (TCP speed capped near people)."""
+    return time_parametrize(
+        path,
+        v_max=s.joint_speed,
+        a_max=s.joint_accel,
+        tcp=tcp_pose(path)[:, :3, 3],
+        tcp_speed=tcp_speed or s.tcp_speed,
+        gripper=gripper,
+    )
+
+
+@dataclass(frozen=True)
+class PickPlan:
+    """The motions of one pick, executed in order with gripper commands between them.
+
+    transit: from the arm's current pose to the pre-grasp (open hand); approach: the straight,
+    guarded line to the grasp; regrip: the straight 2 cm lift before closing again; lift: the
+    straight lift to `lift` above the grasp. Each ends at rest.
+    """
+
+    transit: Trajectory
+    approach: Trajectory
+    regrip: Trajectory
+    lift: Trajectory
+    q_grasp: np.ndarray
+    q_lifted: np.ndarray
+
+
+def plan_pick(
+    q_now: np.ndarray,
+    q_grasp: np.ndarray,
+    world: CollisionChecker,
+    surroundings: CollisionChecker,
+    rng: np.random.Generator,
+    settings: MotionSettings | None = None,
+    via: np.ndarray | None = None,
+) -> PickPlan | Failure:
+    """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
+
+    via: a configuration the transit passes through (the ready pose, from a stowed arm).
+
+    world: the whole cloud; surroundings: the cloud less the target. The arm is checked
+    against the world all the way. The hand is checked against the world on the transit; on
+    the straight approach it is not, because grasp detection swept the hand in along this
+    very line (GPD pushes it in from behind, finger and palm length back), and on the lift
+    only the arm is checked against the surroundings, as the hand rises from its grasp.
+    """
+    s = settings or get_settings().motion
+    T_grasp = tcp_pose(q_grasp)
+    T_pre = T_grasp.copy()
+    T_pre[:3, 3] -= s.approach_distance * T_grasp[:3, 2]
+    pre = ik_tcp(T_pre, q_grasp)
+    if len(pre) == 0:
+        return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
+    q_pre = pre[0]
+    approach = cartesian_line(q_pre, T_grasp, s.cartesian_step)
+    if approach is None or not world.clearance_ok(approach, hand=False).all():
+        return Failure("ik_plan", "The straight approach to this grasp is blocked.")
+    approach[-1] = q_grasp
+    T_up = T_grasp.copy()
+    T_up[2, 3] += s.regrip_lift
+    up = cartesian_line(q_grasp, T_up, s.cartesian_step)
+    T_lift = T_grasp.copy()
+    T_lift[2, 3] += s.lift
+    lift = cartesian_line(up[-1], T_lift, s.cartesian_step) if up is not None else None
+    if up is None or lift is None or not surroundings.clearance_ok(lift, hand=False).all():
+        return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
+    transit = None
+    legs = [q_now, q_pre] if via is None else [q_now, via, q_pre]
+    for a, b in itertools.pairwise(legs):
+        leg = joint_path(a, b, world, rng, s, hand=True)
+        if leg is None:
+            transit = None
+            break
+        transit = leg if transit is None else np.vstack([transit, leg[1:]])
+    if transit is None:
+        return Failure("ik_plan", "No collision-free path to this grasp was found.")
+    return PickPlan(
+        transit=timed(transit, s),
+        approach=timed(approach, s, tcp_speed=s.approach_speed),
+        regrip=timed(up, s, tcp_speed=s.approach_speed),
+        lift=timed(lift, s, tcp_speed=s.approach_speed),
+        q_grasp=q_grasp,
+        q_lifted=lift[-1],
+    )

@@ -1,0 +1,95 @@
+"""The reachability filter (paper 004 section 7): keep the grasps the arm can take without
+touching the cloud, the scooter or its rider.
+
+For each grasp, every analytic IK solution of the grasp pose is tried, nearest the reference
+configuration first; the pre-grasp pose `approach_distance` back along the approach axis must
+then be solvable on the same branch, and both configurations must be collision-free. The
+hand itself is not checked at the grasp (grasp detection did that exactly); it is at the
+pre-grasp. Frames: `base`, metres, radians.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from laserpick.description.kinematics import ik_tcp
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.types import Grasp
+
+#: Largest joint change (rad) between a grasp's and its pre-grasp's solutions: more means the
+#: IK branch flipped, and the straight approach between them would not be straight.
+BRANCH_JUMP = 1.0
+
+
+def flipped(pose: np.ndarray) -> np.ndarray:
+    """The same grasp with the fingers swapped: a half turn about the approach axis."""
+    out = pose.copy()
+    out[:3, :2] *= -1.0
+    return out
+
+
+def pregrasp_pose(pose: np.ndarray, distance: float) -> np.ndarray:
+    """The TCP pose `distance` (m) back along the approach axis from `pose`."""
+    out = pose.copy()
+    out[:3, 3] -= distance * pose[:3, 2]
+    return out
+
+
+def reachable(
+    grasps: Sequence[Grasp],
+    checker: CollisionChecker,
+    q_ref: np.ndarray,
+    approach_distance: float = 0.10,
+) -> list[Grasp]:
+    """The grasps with `ik` set to a collision-free solution, or with `ik_failure` saying why.
+
+    q_ref (6,) rad: where the arm starts the grasp motion (the ready pose). Each grasp is also
+    tried with its fingers swapped, which turns the wrist by a half turn; the nearer wins, and
+    its pose replaces the grasp's.
+    """
+    # Per grasp, its IK options (solution, pose), nearest q_ref first.
+    options: list[list[tuple[np.ndarray, np.ndarray]]] = []
+    failure: dict[int, str] = {}
+    for i, g in enumerate(grasps):
+        ranked = []
+        for k, pose in enumerate((g.pose, flipped(g.pose))):
+            Q = ik_tcp(pose, q_ref)
+            ranked += [(float(np.linalg.norm(q - q_ref)), k, q, pose) for q in Q]
+        ranked.sort(key=lambda o: (o[0], o[1]))
+        options.append([(q, pose) for _, _, q, pose in ranked])
+        failure[i] = "the arm cannot reach this grasp"
+    # Check rank by rank, so most grasps cost one pre-grasp IK and one collision test.
+    chosen: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    for rank in range(max((len(o) for o in options), default=0)):
+        todo, q_grasp, q_pre = [], [], []
+        for i, o in enumerate(options):
+            if i in chosen or rank >= len(o):
+                continue
+            q, pose = o[rank]
+            pre = ik_tcp(pregrasp_pose(pose, approach_distance), q)
+            if len(pre) and np.max(np.abs(pre[0] - q)) < BRANCH_JUMP:
+                todo.append(i)
+                q_grasp.append(q)
+                q_pre.append(pre[0])
+            elif failure[i] == "the arm cannot reach this grasp":
+                failure[i] = "the arm cannot reach the pre-grasp pose behind this grasp"
+        if not todo:
+            continue
+        ok = checker.clearance_ok(np.array(q_grasp), hand=False)
+        ok &= checker.clearance_ok(np.array(q_pre), hand=True)
+        for i, good in zip(todo, ok, strict=True):
+            if good:
+                chosen[i] = options[i][rank]
+            else:
+                failure[i] = "every arm posture for this grasp collides with something"
+    out = []
+    for i, g in enumerate(grasps):
+        if i in chosen:
+            q, pose = chosen[i]
+            out.append(replace(g, pose=pose, ik=q, ik_failure=None))
+        else:
+            out.append(replace(g, ik=None, ik_failure=failure[i]))
+    return out
