@@ -19,8 +19,18 @@ from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.sim_robot import SimRobot
 
-#: The columns of the failure table, in 004's order (Table 1), plus "precondition".
-FAILURE_KINDS = ("detect_laser", "detect_grasp", "ik_plan", "wrong_object", "execute")
+#: The columns of the failure table: 004's kinds (Table 1), and "precondition" (e.g. no object
+#: at the mark).
+#: Marks the operator makes again after the mark itself failed (a missed dot, no object).
+REMARKS = 2
+FAILURE_KINDS = (
+    "detect_laser",
+    "precondition",
+    "detect_grasp",
+    "ik_plan",
+    "wrong_object",
+    "execute",
+)
 
 
 @dataclass
@@ -34,6 +44,7 @@ class Attempt:
     failure: str | None = None  #: a FailureKind, when it did not succeed
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)  #: s per pipeline stage
+    marks: int = 0  #: how many times the operator marked it (re-marks after a failed mark)
 
     @property
     def decide_time(self) -> float:
@@ -76,8 +87,11 @@ def pick_and_drop(
     if aim is None:
         rec.failure, rec.message = "detect_laser", "no camera sees the object"
         return rec
-    frames = mark_and_capture(robot, aim, rng)
-    perception = perceive(frames)
+    # The user sees the failure and marks again, up to REMARKS times (004's users re-aimed).
+    for rec.marks in range(1, REMARKS + 2):
+        perception = perceive(mark_and_capture(robot, aim, rng))
+        if perception.ok:
+            break
     rec.timings.update(perception.timings)
     if not perception.ok:
         assert perception.failure is not None

@@ -50,7 +50,8 @@ def tcp_pose(q: np.ndarray) -> np.ndarray:
     return T_BASE_UR5 @ dh_fk(q) @ T_FLANGE_TCP
 
 
-def _wrap(q: np.ndarray) -> np.ndarray:
+def wrap(q: np.ndarray) -> np.ndarray:
+    """Angles (rad) wrapped to [-pi, pi)."""
     return (q + np.pi) % (2 * np.pi) - np.pi
 
 
@@ -62,11 +63,12 @@ def ik_flange(T_ur5_flange: np.ndarray) -> np.ndarray:
     sols = ur_analytic_ik.ur5.inverse_kinematics(np.ascontiguousarray(T_ur5_flange, dtype=float))
     if not sols:
         return np.zeros((0, 6))
-    Q = _wrap(np.array(sols, dtype=float))
+    Q = wrap(np.array(sols, dtype=float))
     Q = Q[np.all(np.isfinite(Q), axis=1)]
-    # Drop duplicates that the closed form returns at singular poses.
+    # Drop duplicates that the closed form returns at singular poses (keep the first).
     if len(Q) > 1:
-        Q = np.unique(np.round(Q, 9), axis=0)
+        same = np.max(np.abs(Q[:, None] - Q[None]), axis=2) < 1e-9
+        Q = Q[~np.triu(same, k=1).any(axis=0)]
     return Q
 
 
@@ -81,7 +83,7 @@ def ik_tcp(T_base_tcp: np.ndarray, q_ref: np.ndarray | None = None) -> np.ndarra
         return Q
     if q_ref is not None:
         q_ref = np.asarray(q_ref, dtype=float)
-        Q = q_ref + _wrap(Q - q_ref)
+        Q = q_ref + wrap(Q - q_ref)
         Q = Q[np.argsort(np.linalg.norm(Q - q_ref, axis=1))]
     ok = np.all((Q >= dims.UR5_Q_MIN - 1e-9) & (Q <= dims.UR5_Q_MAX + 1e-9), axis=1)
     return Q[ok]

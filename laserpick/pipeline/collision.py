@@ -73,6 +73,8 @@ def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarr
 #: The arm's reach from its shoulder, with the open hand (m): obstacles beyond cannot matter.
 REACH = 1.15
 _SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + 0.089])
+#: Largest voxel table `thin` allocates (entries of 4 bytes).
+DENSE_VOXELS_MAX = 16_000_000
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
 PAYLOAD_POINT_RADIUS = 0.01
 #: A held object is checked against the arm's bodies up to this one (3: wrist 1).
@@ -80,16 +82,25 @@ PAYLOAD_CLEAR_OF_BODY = 3
 
 
 def thin(points: np.ndarray, voxel: float) -> np.ndarray:
-    """Mask of one point (the first) per occupied voxel of edge `voxel` (m)."""
+    """Mask of one point per occupied voxel of edge `voxel` (m).
+
+    Voxels are keyed by one integer; a dense table over the points' bounding box picks a
+    representative per key in linear time (a sort-based unique is 10x slower here), unless
+    the box is too large for the table.
+    """
     keep = np.zeros(len(points), bool)
     if len(points) == 0:
         return keep
-    k = np.floor(points / voxel).astype(np.int64)
-    k -= k.min(axis=0)
+    p = np.asarray(points, np.float32)
+    k = ((p - p.min(axis=0)) * np.float32(1.0 / voxel)).astype(np.int64)  # >= 0: floor
     span = k.max(axis=0) + 1
     key = (k[:, 0] * span[1] + k[:, 1]) * span[2] + k[:, 2]
-    _, first = np.unique(key, return_index=True)
-    keep[first] = True
+    if int(np.prod(span)) <= DENSE_VOXELS_MAX:
+        table = np.full(int(np.prod(span)), -1, np.int32)
+        table[key] = np.arange(len(key), dtype=np.int32)  # one of the points in each voxel
+        keep[table[table >= 0]] = True
+    else:
+        keep[np.unique(key, return_index=True)[1]] = True
     return keep
 
 
@@ -107,6 +118,23 @@ def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.
     for c, r in zip(centres, SPHERES.radius + padding, strict=True):
         keep[tree.query_ball_point(c, r)] = False
     return keep
+
+
+def obstacle_mask(
+    points: np.ndarray, *, voxel: float = 0.01, q_self: np.ndarray | None = None
+) -> np.ndarray:
+    """Mask (N,) of the points worth checking against: finite, within the arm's reach, one
+    per `voxel` (m; 0 keeps all), and not the arm itself at q_self (rad) if given."""
+    d = points - _SHOULDER
+    mask = np.all(np.isfinite(points), axis=1) & (np.einsum("ij,ij->i", d, d) < REACH**2)
+    idx = np.flatnonzero(mask)
+    if voxel > 0:
+        idx = idx[thin(points[idx], voxel)]
+    if q_self is not None:
+        idx = idx[self_filter(points[idx], q_self)]
+    out = np.zeros(len(points), bool)
+    out[idx] = True
+    return out
 
 
 class CollisionChecker:
@@ -127,25 +155,47 @@ class CollisionChecker:
         q_self: np.ndarray | None = None,
     ):
         pts = np.asarray(obstacles, float).reshape(-1, 3)
-        d = pts - _SHOULDER
-        pts = pts[np.all(np.isfinite(pts), axis=1) & (np.einsum("ij,ij->i", d, d) < REACH**2)]
-        if voxel > 0:
-            pts = pts[thin(pts, voxel)]
-        if q_self is not None:
-            pts = pts[self_filter(pts, q_self)]
-        self.points = pts
-        self.tree = cKDTree(pts) if len(pts) else None
+        self.points = pts[obstacle_mask(pts, voxel=voxel, q_self=q_self)]
+        self.tree = cKDTree(self.points) if len(self.points) else None
         self.margin = margin
 
+    @classmethod
+    def world_and_surroundings(
+        cls,
+        points: np.ndarray,
+        target: np.ndarray,
+        *,
+        margin: float = 0.01,
+        voxel: float = 0.01,
+        q_self: np.ndarray | None = None,
+    ) -> tuple[CollisionChecker, CollisionChecker]:
+        """Checkers for the whole cloud and for the cloud without the `target` (indices),
+        sharing one pass of cropping, thinning and self filtering."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        keep = obstacle_mask(pts, voxel=voxel, q_self=q_self)
+        others = keep.copy()
+        others[target] = False
+        return (
+            cls(pts[keep], margin=margin, voxel=0.0),
+            cls(pts[others], margin=margin, voxel=0.0),
+        )
+
     def clearance_ok(
-        self, Q: np.ndarray, *, hand: bool = True, payload: np.ndarray | None = None
+        self,
+        Q: np.ndarray,
+        *,
+        hand: bool = True,
+        payload: np.ndarray | None = None,
+        margin: float | None = None,
     ) -> np.ndarray:
         """(B,) True where configuration Q[b] (B, 6) (rad) collides with nothing.
 
         hand: include the gripper's spheres (grasp detection already checked the hand at the
         grasp itself). payload: a held object's points (P, 3) in the TCP frame (m), each a
-        sphere of PAYLOAD_POINT_RADIUS carried with the hand.
+        sphere of PAYLOAD_POINT_RADIUS carried with the hand. margin: overrides the
+        checker's clearance (m).
         """
+        margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
         frames = body_frames(Q)
         centres = sphere_centres(frames)
@@ -161,16 +211,16 @@ class CollisionChecker:
             upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
             links = sphere_centres(frames)[:, upper]
             gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
-            reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + self.margin
+            reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
             clear &= ~(gap < reach).any(axis=(1, 2))
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
-        return clear & ~self._hits(centres, radius).any(axis=1)
+        return clear & ~self._hits(centres, radius, margin).any(axis=1)
 
-    def _hits(self, centres: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    def _hits(self, centres: np.ndarray, radius: np.ndarray, margin: float) -> np.ndarray:
         """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
         B, S, _ = centres.shape
-        reach = radius[None, :] + self.margin
+        reach = radius[None, :] + margin
         hit = centres[..., 2] < radius + FLOOR_CLEARANCE
         # Distance from each centre to each box (B, S, K).
         gap = np.maximum(_LO - centres[..., None, :], centres[..., None, :] - _HI)
@@ -178,7 +228,7 @@ class CollisionChecker:
         hit |= (d_box < reach[..., None]).any(axis=-1)
         if self.tree is not None:
             flat = centres.reshape(-1, 3)
-            bound = float(radius.max() + self.margin)
+            bound = float(radius.max() + margin)
             d, _ = self.tree.query(flat, k=1, distance_upper_bound=bound)
             hit |= d.reshape(B, S) < reach
         return hit

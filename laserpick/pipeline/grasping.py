@@ -1,7 +1,8 @@
 """From a perceived target to ordered, reachable grasps (004 sections 6.2 and 7), by one of
 three strategies:
 
-- "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004).
+- "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004);
+  when there are none, the "vertical" grasp instead.
 - "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
 - "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
   takes once its base has centred the object (003 section IV).
@@ -29,6 +30,8 @@ from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import Settings, get_settings
 
 Strategy = Literal["gpd", "overhead", "vertical"]
+VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
+VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 
 
@@ -57,23 +60,28 @@ class GraspSet:
         return [g[i] for members in self.clusters.clusters for i in members]
 
 
-def vertical_grasp(target: np.ndarray, settings: Settings) -> Grasp | Failure:
-    """A top-down grasp at the centroid, closing across the narrow side, 2 cm below the top."""
+def vertical_grasp(
+    target: np.ndarray, support: float | None, settings: Settings
+) -> Grasp | Failure:
+    """A top-down grasp at the centroid, closing across the narrow side, the pads reaching
+    2 cm below the top but stopping 3 mm above the support surface at `support` (m)."""
     centre = target.mean(axis=0)
     xy = target[:, :2] - centre[:2]
     _, vecs = np.linalg.eigh(np.cov(xy.T) if len(xy) > 2 else np.eye(2))
     closing = np.append(vecs[:, 0], 0.0)
     across = xy @ vecs[:, 0]
     width = float(across.max() - across.min())
-    if width > settings.grasp.width_max:
+    if width > settings.grasp.width_max - 0.01:
         return Failure("detect_grasp", "The object is wider than the gripper opens.")
     approach = np.array([0.0, 0.0, -1.0])
     pose = np.eye(4)
     pose[:3, 0] = np.cross(closing, approach)
     pose[:3, 1] = closing
     pose[:3, 2] = approach
-    top = float(target[:, 2].max())
-    pose[:3, 3] = [centre[0], centre[1], top - 0.02 + settings.grasp.pad_depth / 2]
+    tips = float(target[:, 2].max()) - VERTICAL_BITE
+    if support is not None:
+        tips = max(tips, support + VERTICAL_FLOOR_GAP)
+    pose[:3, 3] = [centre[0], centre[1], tips + settings.grasp.pad_depth / 2]
     return Grasp(pose=pose, width=width)
 
 
@@ -88,11 +96,12 @@ def candidates(
         return detect_grasps(
             target, cloud.normals[seg.indices], cloud.points, settings.grasp, rng=rng
         )
+    support = seg.surface.height if seg.surface is not None else None
     if strategy == "overhead":
-        support = seg.surface.height if seg.surface is not None else float(target[:, 2].min())
-        g = overhead_grasp(target, cloud.points, support, ARM_MOUNT_POS[:2], settings.grasp)
+        floor = support if support is not None else float(target[:, 2].min())
+        g = overhead_grasp(target, cloud.points, floor, ARM_MOUNT_POS[:2], settings.grasp)
     else:
-        g = vertical_grasp(target, settings)
+        g = vertical_grasp(target, support, settings)
     return g if isinstance(g, Failure) else [g]
 
 
@@ -123,6 +132,11 @@ def find_grasps(
 
     t0 = time.perf_counter()
     found = candidates(perception, strategy, s, rng)
+    if strategy == "gpd" and not found:
+        # GPD needs both sides of a grasp in view; a flat or a round object seen from the
+        # front may offer none. The centroid top grasp is then the fallback (as Jeeves).
+        strategy = "vertical"
+        found = candidates(perception, strategy, s, rng)
     timings["detect"] = time.perf_counter() - t0
     if isinstance(found, Failure):
         return found
@@ -130,11 +144,9 @@ def find_grasps(
         return Failure("detect_grasp", "No grasp fits this object.")
 
     t0 = time.perf_counter()
-    margin = s.motion.clearance
-    others = np.ones(len(cloud), bool)
-    others[seg.indices] = False
-    world = CollisionChecker(cloud.points, margin=margin, q_self=q_capture)
-    surroundings = CollisionChecker(cloud.points[others], margin=margin, q_self=q_capture)
+    world, surroundings = CollisionChecker.world_and_surroundings(
+        cloud.points, seg.indices, margin=s.motion.clearance, q_self=q_capture
+    )
     checked = reachable(found, world, q_ref, s.motion.approach_distance)
     timings["filter"] = time.perf_counter() - t0
     ok = [g for g in checked if g.ik is not None]

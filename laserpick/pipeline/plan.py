@@ -201,10 +201,14 @@ def plan_pick(
     world: the whole cloud; surroundings: the cloud less the target. The arm is checked
     against the world all the way. The hand is checked against the world on the transit; on
     the straight approach it is not, because grasp detection swept the hand in along this
-    very line (GPD pushes it in from behind, finger and palm length back), and on the lift
-    only the arm is checked against the surroundings, as the hand rises from its grasp.
+    very line (GPD pushes it in from behind, finger and palm length back); at the grasp
+    itself the hand must just clear the surroundings (no margin: its fingertips may stop
+    millimetres above the table). On the lift only the arm is checked against the
+    surroundings, as the hand rises from its grasp.
     """
     s = settings or get_settings().motion
+    if not surroundings.clearance_ok(q_grasp, hand=True, margin=0.0)[0]:
+        return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
     T_pre = T_grasp.copy()
     T_pre[:3, 3] -= s.approach_distance * T_grasp[:3, 2]

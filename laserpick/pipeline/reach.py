@@ -15,7 +15,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from laserpick.description.kinematics import ik_tcp
+from laserpick.description.dims import UR5_Q_MAX
+from laserpick.description.kinematics import ik_tcp, wrap
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.types import Grasp
 
@@ -54,12 +55,15 @@ def reachable(
     options: list[list[tuple[np.ndarray, np.ndarray]]] = []
     failure: dict[int, str] = {}
     for i, g in enumerate(grasps):
-        ranked = []
-        for k, pose in enumerate((g.pose, flipped(g.pose))):
-            Q = ik_tcp(pose, q_ref)
-            ranked += [(float(np.linalg.norm(q - q_ref)), k, q, pose) for q in Q]
-        ranked.sort(key=lambda o: (o[0], o[1]))
-        options.append([(q, pose) for _, _, q, pose in ranked])
+        Q = ik_tcp(g.pose, q_ref)
+        # Swapping the fingers is a half turn of the last joint, whose axis is the approach.
+        Q_swap = Q.copy()
+        Q_swap[:, 5] = q_ref[5] + wrap(Q[:, 5] + np.pi - q_ref[5])
+        Q_swap = Q_swap[np.abs(Q_swap[:, 5]) <= UR5_Q_MAX[5]]
+        poses = [g.pose] * len(Q) + [flipped(g.pose)] * len(Q_swap)
+        Q_all = np.vstack([Q, Q_swap])
+        order = np.argsort(np.linalg.norm(Q_all - q_ref, axis=1), kind="stable")
+        options.append([(Q_all[k], poses[k]) for k in order])
         failure[i] = "the arm cannot reach this grasp"
     # Check rank by rank, so most grasps cost one pre-grasp IK and one collision test.
     chosen: dict[int, tuple[np.ndarray, np.ndarray]] = {}

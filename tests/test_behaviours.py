@@ -1,0 +1,109 @@
+"""Executed behaviours on the simulated robot: a guarded approach that meets an unseen
+obstacle stops and backs off, preconditions are checked, and a marked object ends up in the
+basket (judged by the simulator)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from laserpick.behaviours import Behaviours
+from laserpick.bench.operator import Referee
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.perceive import perceive
+from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.pipeline.selection import group, score
+from laserpick.pipeline.trajectory import Trajectory
+from laserpick.pipeline.types import Grasp
+from laserpick.robot.scenes import load_scene
+from laserpick.robot.sim_robot import SimRobot
+
+TABLE_TOP = 0.46  # the isolation scene's table (m)
+
+
+@pytest.fixture
+def robot():
+    r = SimRobot(load_scene("isolation", seed=1), realtime=False)
+    r.sim.settle(0.5)
+    yield r
+    r.close()
+
+
+def _grasp_set(pose: np.ndarray, checker: CollisionChecker) -> GraspSet:
+    """A one-grasp set, as the pipeline would hand it over."""
+    q = ik_tcp(pose, dims.UR5_READY_Q)[0]
+    g = score(
+        Grasp(pose=pose, width=0.05, ik=q),
+        q_now=dims.UR5_READY_Q,
+        sample=pose[:3, 3][None],
+        mark=pose[:3, 3],
+    )
+    target = pose[:3, 3][None]
+    return GraspSet(group([g]), (), checker, checker, target, "vertical")
+
+
+def test_guarded_trajectory_stops_on_contact(robot):
+    T_low = tcp_pose(dims.UR5_READY_Q)
+    T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.05]  # 5 cm into the table
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    path = cartesian_line(robot.joint_state().q, T_low)
+    assert path is not None
+    traj = timed(path, b.settings.motion, tcp_speed=0.05)
+    guarded = Trajectory(traj.times, traj.q, guard_force=25.0)
+    handle = robot.execute(guarded)
+    status = robot.wait(handle, traj.duration + 2.0)
+    assert status == "failed" and "unexpected contact" in handle.message
+    robot.sleep(0.2)
+    s = robot.sim.snapshot()
+    assert np.abs(s.arm_qd).max() < 0.05, "the arm must be at rest after the stop"
+    tcp_z = tcp_pose(s.arm_q)[2, 3]
+    assert tcp_z > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
+
+
+def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
+    # The planner sees nothing (an empty cloud); the grasp is 4 cm into the table top.
+    pose = np.eye(4)
+    pose[:3, :3] = np.diag([1.0, -1.0, -1.0])
+    pose[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.04 + 0.011]
+    b = Behaviours(robot)
+    out = b.pick(_grasp_set(pose, CollisionChecker(np.zeros((0, 3)))))
+    assert not out.ok and out.failure.kind == "execute"
+    assert "touched something" in out.failure.message
+    robot.sleep(0.3)
+    s = robot.sim.snapshot()
+    assert np.abs(s.arm_qd).max() < 0.05
+    assert tcp_pose(s.arm_q)[2, 3] > TABLE_TOP + 0.03, "it backed off upward"
+    assert not s.gripper_closed
+
+
+def test_preconditions_are_checked(robot):
+    b = Behaviours(robot)
+    out = b.drop_in_basket()
+    assert out.failure is not None and out.failure.kind == "precondition"
+
+
+def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
+    referee = Referee(robot)
+    name = "mug_1"
+    aim = referee.aim_point(name)
+    assert aim is not None
+    perception = perceive(robot.capture(), point=aim)
+    assert perception.ok, perception.failure
+    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+    assert isinstance(found, GraspSet), found
+    b = Behaviours(robot)
+    out = b.pick(found)
+    assert out.ok, out.failure
+    names = [p.instance for p in robot.sim.scene.placements]
+    assert referee.grasped_object(out.grasp, names) == name
+    assert robot.gripper_state().holding
+    assert referee.position(name)[2] > TABLE_TOP + 0.08, "lifted"
+    dropped = b.drop_in_basket()
+    assert dropped.ok, dropped.failure
+    robot.sleep(1.0)
+    assert referee.in_basket(name)
+    assert not robot.gripper_state().closed

@@ -1,0 +1,208 @@
+"""The arm's collision model, the reachability filter and the planners (004 section 7)."""
+
+from __future__ import annotations
+
+import itertools
+
+import mujoco
+import numpy as np
+import pytest
+
+from laserpick.description import dims
+from laserpick.description.collision import KEEPOUT_BOXES, body_frames
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import (
+    SPHERES,
+    CollisionChecker,
+    self_filter,
+    sphere_centres,
+    thin,
+)
+from laserpick.pipeline.plan import cartesian_line, joint_path, plan_pick, rrt_connect, shortcut
+from laserpick.pipeline.reach import reachable
+from laserpick.pipeline.types import Failure, Grasp
+from laserpick.robot.model import ModelInfo, build_sim_model
+from laserpick.settings import get_settings
+
+EMPTY = np.zeros((0, 3))
+
+
+def top_grasp(x: float, y: float, z: float, yaw: float = 0.0) -> np.ndarray:
+    """A TCP pose at (x, y, z) in `base` with the approach straight down."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    T = np.eye(4)
+    T[:3, :3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.diag([1.0, -1.0, -1.0])
+    T[:3, 3] = [x, y, z]
+    return T
+
+
+def table(z: float = 0.46, x=(1.3, 1.9), y=(-0.65, 0.35), step: float = 0.01) -> np.ndarray:
+    xs, ys = np.meshgrid(np.arange(*x, step), np.arange(*y, step))
+    return np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, z)]
+
+
+def test_body_frames_match_the_simulated_links():
+    m = build_sim_model(None)
+    d = mujoco.MjData(m)
+    info = ModelInfo.of(m)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = rng.uniform(-3, 3, 6)
+        d.qpos[info.arm_qpos] = q
+        mujoco.mj_kinematics(m, d)
+        F = body_frames(q)[0]
+        for i in range(6):
+            b = m.body(f"ur5/link{i + 1}").id
+            assert np.allclose(d.xpos[b], F[i, :3, 3], atol=1e-9)
+            assert np.allclose(d.xmat[b].reshape(3, 3), F[i, :3, :3], atol=1e-9)
+        # The sphere model covers each MuJoCo capsule's end points.
+        centres = sphere_centres(body_frames(q))[0]
+        for g in range(m.ngeom):
+            name = m.geom(g).name
+            if not (name.startswith("ur5/link") and "/c" in name):
+                continue
+            half = m.geom_size[g, 1]
+            axis = d.geom_xmat[g].reshape(3, 3)[:, 2]
+            for end in (d.geom_xpos[g] + half * axis, d.geom_xpos[g] - half * axis):
+                gap = np.linalg.norm(centres - end, axis=1) - SPHERES.radius
+                assert gap.min() < -m.geom_size[g, 0] + 1e-6
+
+
+def test_stowed_and_ready_poses_are_clear_and_the_checker_sees_what_it_should():
+    free = CollisionChecker(EMPTY)
+    assert free.clearance_ok(np.stack([dims.UR5_HOME_Q, dims.UR5_READY_Q])).all()
+    # A point where the wrist is makes the ready pose collide, and is named "cloud".
+    wrist = tcp_pose(dims.UR5_READY_Q)[:3, 3] + [0, 0, 0.15]
+    blocked = CollisionChecker(wrist[None], voxel=0.0)
+    assert not blocked.clearance_ok(dims.UR5_READY_Q)[0]
+    assert blocked.what_hits(dims.UR5_READY_Q) == ["cloud"]
+    # The TCP through the floor, and into the rider's seat.
+    for T, what in ((top_grasp(1.5, -0.3, 0.0), "floor"), (top_grasp(0.6, -0.1, 0.8), "rider")):
+        Q = ik_tcp(T, dims.UR5_READY_Q)
+        assert len(Q)
+        assert not free.clearance_ok(Q).any()
+        assert what in free.what_hits(Q[0])
+
+
+def test_keepout_boxes_are_well_formed():
+    for b in KEEPOUT_BOXES:
+        assert np.all(np.array(b.lo) < np.array(b.hi)), b.name
+
+
+def test_thin_keeps_one_point_per_voxel():
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(0, 0.2, (5000, 3))
+    keep = thin(pts, 0.05)
+    cells = np.floor((pts - pts.min(axis=0)) / 0.05).astype(int)
+    assert keep.sum() == len(np.unique(cells, axis=0))
+    assert len(np.unique(cells[keep], axis=0)) == keep.sum()
+
+
+def test_self_filter_removes_the_arm_and_keeps_the_rest():
+    q = dims.UR5_READY_Q
+    centres = sphere_centres(body_frames(q))[0]
+    on_arm = centres + np.random.default_rng(1).normal(0, 0.01, centres.shape)
+    away = np.array([[1.5, 0.2, 0.5], [1.8, -0.3, 0.47]])
+    keep = self_filter(np.vstack([on_arm, away]), q)
+    assert not keep[: len(on_arm)].any()
+    assert keep[len(on_arm) :].all()
+
+
+def test_filter_keeps_reachable_grasps_and_says_why_it_drops_others():
+    checker = CollisionChecker(table())
+    ok = Grasp(top_grasp(1.5, -0.3, 0.52), 0.05)
+    far = Grasp(top_grasp(2.6, 0.0, 0.52), 0.05)
+    # A grasp whose pre-grasp lies inside a box of points.
+    wall_x = np.arange(1.55, 1.75, 0.01)
+    wall = np.array([[x, y, z] for x in wall_x for y in (-0.1, 0.0) for z in (0.62, 0.66)])
+    walled = Grasp(top_grasp(1.65, -0.05, 0.52), 0.05)
+    checker = CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
+    out = reachable([ok, far, walled], checker, dims.UR5_READY_Q)
+    assert out[0].ik is not None and out[0].ik_failure is None
+    assert np.allclose(tcp_pose(out[0].ik)[:3, 3], ok.position, atol=1e-6)
+    assert out[1].ik is None and "cannot reach" in out[1].ik_failure
+    assert out[2].ik is None and "collides" in out[2].ik_failure
+
+
+def test_filter_swaps_the_fingers_when_that_turns_the_wrist_less():
+    q_ref = dims.UR5_READY_Q
+    yaw = np.pi  # the ready pose's hand turned by a half turn
+    T = tcp_pose(q_ref) @ np.diag([-1.0, -1.0, 1.0, 1.0])
+    out = reachable([Grasp(T, 0.05)], CollisionChecker(EMPTY), q_ref)[0]
+    assert out.ik is not None
+    assert abs(out.ik[5] - q_ref[5]) < 1e-6, "swapped fingers need no wrist turn"
+    assert np.allclose(out.pose[:3, 0], -T[:3, 0]) and yaw
+
+
+def test_cartesian_line_is_straight():
+    q0 = dims.UR5_READY_Q
+    T0 = tcp_pose(q0)
+    T1 = T0.copy()
+    T1[:3, 3] += [0.05, 0.1, -0.25]
+    path = cartesian_line(q0, T1, 0.01)
+    assert path is not None
+    p = tcp_pose(path)[:, :3, 3]
+    d = (T1[:3, 3] - T0[:3, 3]) / np.linalg.norm(T1[:3, 3] - T0[:3, 3])
+    off = (p - T0[:3, 3]) - np.outer((p - T0[:3, 3]) @ d, d)
+    assert np.linalg.norm(off, axis=1).max() < 1e-3
+    assert np.allclose(tcp_pose(path[-1]), T1, atol=1e-6)
+
+
+def test_rrt_connect_goes_around_a_wall_and_every_step_is_clear():
+    rng = np.random.default_rng(0)
+    q0 = ik_tcp(top_grasp(1.6, -0.5, 0.65), dims.UR5_READY_Q)[0]
+    q1 = ik_tcp(top_grasp(1.6, 0.1, 0.65), dims.UR5_READY_Q)[0]
+    # A wall of points between the two, from the table up to 0.8 m.
+    wall = np.array(
+        [[x, -0.2, z] for x in np.arange(1.45, 1.75, 0.02) for z in np.arange(0.46, 0.8, 0.02)]
+    )
+    checker = CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
+    assert checker.clearance_ok(np.stack([q0, q1])).all()
+    assert not checker.segment_ok(q0, q1)
+    path = rrt_connect(q0, q1, checker, rng, step=0.3, max_samples=3000)
+    assert path is not None
+    assert np.allclose(path[0], q0) and np.allclose(path[-1], q1)
+    assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
+    short = shortcut(path, checker, rng)
+    assert len(short) <= len(path)
+    assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(short))
+    via = joint_path(q0, q1, checker, rng, get_settings().motion)
+    assert via is not None and len(via) > 2
+
+
+def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
+    s = get_settings().motion
+    world = CollisionChecker(table())
+    T = top_grasp(1.55, -0.25, 0.50, yaw=0.4)
+    q_grasp = ik_tcp(T, dims.UR5_READY_Q)[0]
+    plan = plan_pick(
+        dims.UR5_HOME_Q, q_grasp, world, world, np.random.default_rng(0), s, via=dims.UR5_READY_Q
+    )
+    assert not isinstance(plan, Failure), plan
+    assert np.allclose(plan.transit.q[0], dims.UR5_HOME_Q)
+    assert np.allclose(plan.transit.q[-1], plan.approach.q[0])
+    # The approach ends at the grasp, coming straight down the approach axis.
+    start, end = tcp_pose(plan.approach.q[[0, -1]])
+    assert np.allclose(end, T, atol=1e-6)
+    assert np.allclose(start[:3, 3] - end[:3, 3], [0, 0, s.approach_distance], atol=1e-6)
+    top = tcp_pose(plan.lift.q[-1])[:3, 3]
+    assert np.isclose(top[2] - T[2, 3], s.lift, atol=1e-6)
+    for traj in (plan.transit, plan.approach, plan.regrip, plan.lift):
+        qd = np.diff(traj.q, axis=0) / np.diff(traj.times)[:, None]
+        assert np.abs(qd).max() <= s.joint_speed * 1.02
+    tcp = tcp_pose(plan.approach.q)[:, :3, 3]
+    v = np.linalg.norm(np.diff(tcp, axis=0), axis=1) / np.diff(plan.approach.times)
+    assert v.max() <= s.approach_speed * 1.05
+
+
+def test_plan_pick_refuses_a_grasp_under_the_table():
+    world = CollisionChecker(table())
+    q = ik_tcp(top_grasp(1.55, -0.25, 0.40), dims.UR5_READY_Q)[0]
+    plan = plan_pick(dims.UR5_READY_Q, q, world, world, np.random.default_rng(0))
+    assert isinstance(plan, Failure) and plan.kind == "ik_plan"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_checker_ignores_non_finite_points(bad):
+    pts = np.array([[1.5, -0.3, bad], [5.0, 5.0, 5.0]])
+    assert len(CollisionChecker(pts).points) == 0
