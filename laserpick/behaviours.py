@@ -20,14 +20,16 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, thin
 from laserpick.pipeline.grasping import GraspSet
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, plan_pick, timed
+from laserpick.pipeline.surface import place_target
 from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import Failure, Grasp
+from laserpick.pipeline.types import Failure, FusedCloud, Grasp
 from laserpick.robot.interface import Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.transforms import roty, rotz
@@ -36,18 +38,22 @@ log = logging.getLogger(__name__)
 
 #: Time (s) the gripper gets to close or open: the full 85 mm stroke at 0.15 m/s, plus margin.
 GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
+#: Points this close (m) to a held object's points are taken to be the object itself.
+CARRIED_PADDING = 0.03
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
 MOTION_SLACK = 3.0
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage."""
+    """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage;
+    spot: where a place set the object down (the surface point under the TCP, m, `base`)."""
 
     failure: Failure | None = None
     grasp: Grasp | None = None
     attempts: int = 0
     timings: dict[str, float] = field(default_factory=dict)
+    spot: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -262,3 +268,69 @@ class Behaviours:
         self.held = None
         self.progress("Released into the basket.")
         return self.go_ready(held.surroundings)
+
+    def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
+        """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).
+
+        cloud: a fresh capture's fused cloud (the held object and the arm in it are ignored);
+        mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
+        its front edge if it is too close). The object goes down with the grasp's orientation
+        kept, so that it stands as it stood, its grasp height above the surface: straight
+        down from 10 cm above, guarded, then the hand opens and rises straight back.
+        """
+        s = self.settings.motion
+        if self.held is None or not self.robot.gripper_state().holding:
+            self.held = None
+            return Outcome(Failure("precondition", "The hand is not holding anything."))
+        held = self.held
+        spot = place_target(cloud, mark, self.settings.perception)
+        if isinstance(spot, Failure):
+            return Outcome(Failure("precondition", f"I can't place there: {spot.message}."))
+        q_now = self._q()
+        obstacles = cloud.points[self._not_carried(cloud.points, q_now, held)]
+        checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
+        T_place = held.grasp.pose.copy()
+        T_place[:3, 3] = [
+            spot[0],
+            spot[1],
+            spot[2] + held.height_above_support + s.place_clearance,
+        ]
+        T_above = T_place.copy()
+        T_above[2, 3] += s.approach_distance
+        solutions = ik_tcp(T_above, q_now)
+        q_above = next(
+            (q for q in solutions if checker.clearance_ok(q, payload=held.points_tcp)[0]), None
+        )
+        if q_above is None:
+            return Outcome(Failure("ik_plan", "The arm cannot reach above that spot."))
+        down = cartesian_line(q_above, T_place, s.cartesian_step)
+        if down is None:
+            return Outcome(Failure("ik_plan", "The arm cannot lower the object there."))
+        self.progress("Carrying the object to the place mark.")
+        out = self.go_to(q_above, checker, "carrying to the place", payload=held.points_tcp)
+        if not out.ok:
+            return out
+        lowering = timed(down, s, tcp_speed=s.approach_speed)
+        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.guard_force)
+        failure = self._run(guarded, "lowering the object")
+        if failure is not None and "unexpected contact" not in failure.message:
+            return Outcome(failure)
+        # Touching the surface early (a guard stop) is where the object should be let go.
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        self.held = None
+        up = cartesian_line(self._q(), T_above, s.cartesian_step)
+        if up is not None:
+            self._run(timed(up, s, tcp_speed=s.approach_speed), "rising from the object")
+        self.progress("Placed.")
+        return Outcome(None, held.grasp, spot=spot)
+
+    @staticmethod
+    def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:
+        """Mask of the points that are not the held object, at joint angles q (6,)."""
+        T = tcp_pose(q)
+        carried = held.points_tcp @ T[:3, :3].T + T[:3, 3]
+        if len(carried) == 0:
+            return np.ones(len(points), bool)
+        d, _ = cKDTree(carried).query(points, distance_upper_bound=CARRIED_PADDING)
+        return ~np.isfinite(d)

@@ -18,12 +18,16 @@ from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.types import DepthFrame, Grasp
+from laserpick.robot.scenes import Surface
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import invert, planar_pose
 
 #: Hand tremor: the aim's angular noise, standard deviation (rad). About 5 mm at 1 m, a
 #: steady hand resting on the scooter's armrest. Ours; 004 does not measure it.
 TREMOR_STD = math.radians(0.3)
+#: m behind a surface's front edge that the user parks to work at (the isolation table's
+#: objects stand 5-45 cm behind its edge at 1.30 m).
+PARK_SPOT_DEPTH = 0.25
 
 
 @dataclass
@@ -34,6 +38,19 @@ class Referee:
 
     def _T_base_world(self) -> np.ndarray:
         return invert(planar_pose(*self.robot.sim.snapshot().base_pose))
+
+    def instances(self) -> list[str]:
+        """The scene's object instances."""
+        return [p.instance for p in self.robot.sim.scene.placements]  # type: ignore[union-attr]
+
+    def world_position(self, instance: str) -> np.ndarray:
+        """The object's centre of mass in `world` (m)."""
+        return self.robot.sim.snapshot().xpos[self.robot.sim.info.object_bodies[instance]].copy()
+
+    def world_quat(self, instance: str) -> np.ndarray:
+        """The object's orientation in `world` (w, x, y, z)."""
+        b = self.robot.sim.info.object_bodies[instance]
+        return self.robot.sim.snapshot().xquat[b].copy()
 
     def position(self, instance: str) -> np.ndarray:
         """The object's centre of mass in `base` (m)."""
@@ -102,3 +119,80 @@ def mark_and_capture(
     frames = robot.capture()
     robot.laser.off()
     return frames
+
+
+def parking_pose(surface: Surface, local_y: float = 0.0) -> np.ndarray:
+    """Where the user parks to work on `surface`: facing it, its front edge 1.30 m ahead of
+    the rear axle and the spot `local_y` (m, the surface's frame) in front of the arm.
+    Returns (x, y, yaw) in `world` (m, rad)."""
+    yaw = surface.yaw  # the front faces the surface's local -x: face its +x
+    c, s = math.cos(yaw), math.sin(yaw)
+    front_x = -surface.size[0] / 2
+    spot_local = np.array([front_x + PARK_SPOT_DEPTH, local_y])
+    spot = np.asarray(surface.xy) + np.array(
+        [c * spot_local[0] - s * spot_local[1], s * spot_local[0] + c * spot_local[1]]
+    )
+    reach = np.array([1.30 + PARK_SPOT_DEPTH, dims.ARM_MOUNT_POS[1]])
+    origin = spot - np.array([c * reach[0] - s * reach[1], s * reach[0] + c * reach[1]])
+    return np.array([origin[0], origin[1], yaw])
+
+
+def drive_to(robot: SimRobot, goal: np.ndarray, *, reverse_first: float = 0.0) -> bool:
+    """Drive like a careful user: back out `reverse_first` m, turn toward a point 0.8 m in
+    front of the goal, drive there, turn to face the goal and creep in. Headless. Returns
+    whether the scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`)."""
+    goal = np.asarray(goal, float)
+    approach = goal[:2] - 0.8 * np.array([math.cos(goal[2]), math.sin(goal[2])])
+    if reverse_first > 0:
+        start = robot.base_pose()[:2].copy()
+        _drive_loop(robot, lambda p: (-0.3, 0.0, np.linalg.norm(p[:2] - start) >= reverse_first))
+    _go_point(robot, approach)
+    _turn_to(robot, goal[2])
+    _go_point(robot, goal[:2], speed=0.2)
+    _turn_to(robot, goal[2])
+    p = robot.base_pose()
+    return bool(np.linalg.norm(p[:2] - goal[:2]) < 0.03 and abs(_wrap(p[2] - goal[2])) < 0.035)
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _drive_loop(robot: SimRobot, command, timeout: float = 60.0) -> None:
+    """Send drive commands every 0.1 s until command(pose) says done (or `timeout` s)."""
+    t = 0.0
+    while t < timeout:
+        v, w, done = command(robot.base_pose())
+        if done:
+            break
+        robot.drive(v, w, 0.3)
+        robot.sleep(0.1)
+        t += 0.1
+    robot.drive(0.0, 0.0, 0.3)
+    robot.sleep(1.0)  # the ramp down
+
+
+def _turn_to(robot: SimRobot, yaw: float) -> None:
+    def cmd(p):
+        err = _wrap(yaw - p[2])
+        return 0.0, float(np.clip(1.5 * err, -0.6, 0.6)), abs(err) < 0.01
+
+    _drive_loop(robot, cmd)
+
+
+def _go_point(robot: SimRobot, xy: np.ndarray, speed: float = 0.5) -> None:
+    def heading(p):
+        d = xy - p[:2]
+        return math.atan2(d[1], d[0])
+
+    if np.linalg.norm(xy - robot.base_pose()[:2]) > 0.02:
+        _turn_to(robot, heading(robot.base_pose()))
+
+    def cmd(p):
+        d = xy - p[:2]
+        dist = float(np.linalg.norm(d))
+        err = _wrap(math.atan2(d[1], d[0]) - p[2])
+        v = min(speed, 0.8 * dist) * max(0.0, math.cos(err))
+        return v, float(np.clip(1.5 * err, -0.6, 0.6)) if dist > 0.05 else 0.0, dist < 0.01
+
+    _drive_loop(robot, cmd)

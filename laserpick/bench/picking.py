@@ -63,7 +63,7 @@ def stow(robot: SimRobot, behaviours: Behaviours) -> None:
         raise RuntimeError(f"the arm could not stow: {out.failure}")
 
 
-def pick_and_drop(
+def mark_and_pick(
     robot: SimRobot,
     behaviours: Behaviours,
     referee: Referee,
@@ -73,7 +73,7 @@ def pick_and_drop(
     strategy: Strategy = "gpd",
     choose: str = "auto",
 ) -> Attempt:
-    """Mark `instance`, pick it and drop it in the basket; the arm starts and ends stowed.
+    """Mark `instance` and pick it; on success the hand holds it 10 cm up.
 
     choose: "auto" tries the grasps in score order (004 section 7.4); "manual" plays a user
     who steps through the clusters to the first whose best grasp is on the marked object
@@ -104,24 +104,38 @@ def pick_and_drop(
         rec.failure, rec.message = found.kind, found.message
         return rec
     rec.timings.update(found.timings)
-    order = choose_order(found, choose, referee, instance)
-    outcome = behaviours.pick(found, order)
+    outcome = behaviours.pick(found, choose_order(found, choose, referee, instance))
     rec.timings.update(outcome.timings)
     if outcome.grasp is not None:
         rec.detected = referee.grasped_object(outcome.grasp, names) == instance
-    dropped = behaviours.drop_in_basket() if outcome.ok else None
-    robot.sleep(1.0)
-    rec.success = rec.detected and referee.in_basket(instance)
-    if rec.success:
-        return rec
     if outcome.grasp is not None and not rec.detected:
         rec.failure, rec.message = "wrong_object", "the chosen grasp was on another object"
     elif outcome.failure is not None:
         rec.failure, rec.message = outcome.failure.kind, outcome.failure.message
-    elif dropped is not None and dropped.failure is not None:
-        rec.failure, rec.message = dropped.failure.kind, dropped.failure.message
-    else:
-        rec.failure, rec.message = "execute", "the object did not land in the basket"
+    return rec
+
+
+def pick_and_drop(
+    robot: SimRobot,
+    behaviours: Behaviours,
+    referee: Referee,
+    instance: str,
+    rng: np.random.Generator,
+    *,
+    strategy: Strategy = "gpd",
+    choose: str = "auto",
+) -> Attempt:
+    """Mark `instance`, pick it and drop it in the basket; success is the simulator's word
+    that the marked object lies in the basket."""
+    rec = mark_and_pick(robot, behaviours, referee, instance, rng, strategy=strategy, choose=choose)
+    if rec.failure is not None or not rec.detected:
+        return rec
+    dropped = behaviours.drop_in_basket()
+    robot.sleep(1.0)
+    rec.success = referee.in_basket(instance)
+    if not rec.success:
+        failure = dropped.failure or Failure("execute", "the object did not land in the basket")
+        rec.failure, rec.message = failure.kind, failure.message
     return rec
 
 
