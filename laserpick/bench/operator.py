@@ -52,6 +52,17 @@ class Referee:
         b = self.robot.sim.info.object_bodies[instance]
         return self.robot.sim.snapshot().xquat[b].copy()
 
+    def take_out(self, instance: str) -> None:
+        """Lift the object out of the scene (to the floor 5 m behind the scooter), as a helper
+        empties the basket between trials: objects in the basket stand in the laser's way."""
+
+        def move(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+            j = m.joint(f"obj/{instance}")
+            d.qpos[j.qposadr[0] : j.qposadr[0] + 3] = [-5.0, 0.0, 0.5]
+            d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
+
+        self.robot.sim.call(move)
+
     def position(self, instance: str) -> np.ndarray:
         """The object's centre of mass in `base` (m)."""
         b = self.robot.sim.info.object_bodies[instance]
@@ -80,11 +91,19 @@ class Referee:
         world = np.vstack(pts)
         return (self._T_base_world() @ np.c_[world, np.ones(len(world))].T).T[:, :3]
 
-    def grasped_object(self, grasp: Grasp, instances: list[str]) -> str | None:
-        """The object nearest the grasp's TCP (within 4 cm), or None."""
+    def all_object_points(self) -> dict[str, np.ndarray]:
+        """`object_points` of every object, now: take it before a pick moves them."""
+        return {name: self.object_points(name) for name in self.instances()}
+
+    def grasped_object(
+        self, grasp: Grasp, instances: list[str], points: dict[str, np.ndarray] | None = None
+    ) -> str | None:
+        """The object nearest the grasp's TCP (within 4 cm), or None. points: the objects'
+        points as they stood before the grasp (default: as they stand now)."""
         best, best_d = None, 0.04
         for name in instances:
-            d = float(np.min(np.linalg.norm(self.object_points(name) - grasp.position, axis=1)))
+            pts = points[name] if points is not None else self.object_points(name)
+            d = float(np.min(np.linalg.norm(pts - grasp.position, axis=1)))
             if d < best_d:
                 best, best_d = name, d
         return best

@@ -104,10 +104,11 @@ def mark_and_pick(
         rec.failure, rec.message = found.kind, found.message
         return rec
     rec.timings.update(found.timings)
-    outcome = behaviours.pick(found, choose_order(found, choose, referee, instance))
+    before = referee.all_object_points()  # judge the grasp against the scene it was made for
+    outcome = behaviours.pick(found, choose_order(found, choose, referee, instance, before))
     rec.timings.update(outcome.timings)
     if outcome.grasp is not None:
-        rec.detected = referee.grasped_object(outcome.grasp, names) == instance
+        rec.detected = referee.grasped_object(outcome.grasp, names, before) == instance
     if outcome.grasp is not None and not rec.detected:
         rec.failure, rec.message = "wrong_object", "the chosen grasp was on another object"
     elif outcome.failure is not None:
@@ -133,20 +134,28 @@ def pick_and_drop(
     dropped = behaviours.drop_in_basket()
     robot.sleep(1.0)
     rec.success = referee.in_basket(instance)
-    if not rec.success:
+    if rec.success:
+        referee.take_out(instance)
+    else:
         failure = dropped.failure or Failure("execute", "the object did not land in the basket")
         rec.failure, rec.message = failure.kind, failure.message
     return rec
 
 
-def choose_order(found: GraspSet, choose: str, referee: Referee, instance: str) -> list[Grasp]:
+def choose_order(
+    found: GraspSet,
+    choose: str,
+    referee: Referee,
+    instance: str,
+    points: dict[str, np.ndarray] | None = None,
+) -> list[Grasp]:
     """The grasps to try, in order, for automatic or (scripted) manual selection."""
     if choose == "auto":
         return found.ordered()
-    names = [p.instance for p in referee.robot.sim.scene.placements]  # type: ignore[union-attr]
+    names = referee.instances()
     grasps, clusters = found.clusters.grasps, found.clusters.clusters
     for members in clusters:  # the user toggles through clusters, best first
-        if referee.grasped_object(grasps[members[0]], names) == instance:
+        if referee.grasped_object(grasps[members[0]], names, points) == instance:
             return [grasps[i] for i in members]
     return found.ordered()  # no cluster on the target: the user accepts the system's choice
 

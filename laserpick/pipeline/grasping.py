@@ -2,7 +2,7 @@
 three strategies:
 
 - "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004);
-  when there are none, the "vertical" grasp instead.
+  when none of them is reachable, the "vertical" grasp instead.
 - "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
 - "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
   takes once its base has centred the object (003 section IV).
@@ -32,6 +32,7 @@ from laserpick.settings import Settings, get_settings
 Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
 VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
+VERTICAL_SLACK = 0.005  #: m of the stroke left over a vertical grasp's width
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 
 
@@ -71,7 +72,7 @@ def vertical_grasp(
     closing = np.append(vecs[:, 0], 0.0)
     across = xy @ vecs[:, 0]
     width = float(across.max() - across.min())
-    if width > settings.grasp.width_max - 0.01:
+    if width > settings.grasp.width_max - VERTICAL_SLACK:
         return Failure("detect_grasp", "The object is wider than the gripper opens.")
     approach = np.array([0.0, 0.0, -1.0])
     pose = np.eye(4)
@@ -129,31 +130,38 @@ def find_grasps(
     timings: dict[str, float] = {}
     cloud, seg = perception.cloud, perception.segmentation
     target = cloud.points[seg.indices].astype(np.float64)
+    approach = s.motion.approach_distance
 
     t0 = time.perf_counter()
     found = candidates(perception, strategy, s, rng)
-    if strategy == "gpd" and not found:
-        # GPD needs both sides of a grasp in view; a flat or a round object seen from the
-        # front may offer none. The centroid top grasp is then the fallback (as Jeeves).
-        strategy = "vertical"
-        found = candidates(perception, strategy, s, rng)
     timings["detect"] = time.perf_counter() - t0
-    if isinstance(found, Failure):
-        return found
-    if not found:
-        return Failure("detect_grasp", "No grasp fits this object.")
-
     t0 = time.perf_counter()
     world, surroundings = CollisionChecker.world_and_surroundings(
         cloud.points, seg.indices, margin=s.motion.clearance, q_self=q_capture
     )
-    checked = reachable(found, world, q_ref, s.motion.approach_distance)
+    checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
+    if strategy == "gpd" and not any(g.ik is not None for g in checked):
+        # GPD needs both sides of a grasp in view and room for the hand toward them: a low,
+        # a round or a near object may offer no reachable candidate. The centroid top grasp
+        # (Jeeves') is then the fallback.
+        t0 = time.perf_counter()
+        fallback = candidates(perception, "vertical", s, rng)
+        timings["detect"] += time.perf_counter() - t0
+        if not isinstance(fallback, Failure):
+            t0 = time.perf_counter()
+            checked += reachable(fallback, world, q_ref, approach)
+            timings["filter"] += time.perf_counter() - t0
+            strategy = "vertical"
+    if isinstance(found, Failure) and not checked:
+        return found
+    if not checked:
+        return Failure("detect_grasp", "No grasp fits this object.")
     ok = [g for g in checked if g.ik is not None]
     rejected = tuple(g for g in checked if g.ik is None)
     if not ok:
-        reason = rejected[0].ik_failure if rejected else "no grasp"
-        return Failure("ik_plan", f"The arm cannot take any of {len(found)} grasps ({reason}).")
+        reason = rejected[0].ik_failure
+        return Failure("ik_plan", f"The arm cannot take any of {len(checked)} grasps ({reason}).")
 
     t0 = time.perf_counter()
     mark = perception.mark.point

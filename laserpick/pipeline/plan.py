@@ -28,6 +28,10 @@ from laserpick.settings import MotionSettings, get_settings
 #: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
 #: step means the IK jumped branches (a singularity), so the line is not followed.
 CARTESIAN_JUMP = 0.25
+#: How far (m) the hand's spheres may overlap surrounding points at the grasp: the finger
+#: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
+#: support's points scatter by a few millimetres.
+HAND_CONTACT_TOLERANCE = 0.004
 
 
 def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
@@ -202,12 +206,12 @@ def plan_pick(
     against the world all the way. The hand is checked against the world on the transit; on
     the straight approach it is not, because grasp detection swept the hand in along this
     very line (GPD pushes it in from behind, finger and palm length back); at the grasp
-    itself the hand must just clear the surroundings (no margin: its fingertips may stop
-    millimetres above the table). On the lift only the arm is checked against the
-    surroundings, as the hand rises from its grasp.
+    itself the hand's spheres may dip HAND_CONTACT_TOLERANCE into the surroundings (its
+    fingertips stop millimetres above the table, whose points scatter by as much). On the
+    lift only the arm is checked against the surroundings, as the hand rises from its grasp.
     """
     s = settings or get_settings().motion
-    if not surroundings.clearance_ok(q_grasp, hand=True, margin=0.0)[0]:
+    if not surroundings.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]:
         return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
     T_pre = T_grasp.copy()
