@@ -24,20 +24,25 @@ from scipy.spatial import cKDTree
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.collision import CollisionChecker, thin
 from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, plan_pick, timed
 from laserpick.pipeline.surface import place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
 from laserpick.robot.interface import Robot
 from laserpick.settings import Settings, get_settings
-from laserpick.transforms import roty, rotz
+from laserpick.transforms import invert, planar_pose, roty, rotz
 
 log = logging.getLogger(__name__)
 
 #: Time (s) the gripper gets to close or open: the full 85 mm stroke at 0.15 m/s, plus margin.
 GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
+#: Seconds between the centroid approach's control steps (each re-perceives the target).
+APPROACH_PERIOD = 0.25
+APPROACH_MAX_STEPS = 240
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
@@ -161,7 +166,14 @@ class Behaviours:
             attempts += 1
             assert grasp.ik is not None
             plan = plan_pick(
-                q_now, grasp.ik, grasps.world, grasps.surroundings, self.rng, s, via=via
+                q_now,
+                grasp.ik,
+                grasps.world,
+                grasps.surroundings,
+                self.rng,
+                s,
+                via=via,
+                check_hand=grasps.strategy == "vertical",  # the others checked the hand
             )
             if not isinstance(plan, Failure):
                 break
@@ -334,3 +346,33 @@ class Behaviours:
             return np.ones(len(points), bool)
         d, _ = cKDTree(carried).query(points, distance_upper_bound=CARRIED_PADDING)
         return ~np.isfinite(d)
+
+    def approach(self, perception: Perception) -> Perception | Failure:
+        """Jeeves' centroid approach (003 section IV): drive the base until the perceived
+        target's centroid sits at the arm's grasping spot, re-perceiving it as the scooter
+        moves (where to look comes from the wheel odometry: the target's top, a point on its
+        surface). Returns the last perception of the target, for the grasp."""
+        if perception.segmentation is None:
+            return Failure("precondition", "There is no target to drive to.")
+        pose = self.robot.base_pose()
+        for _ in range(APPROACH_MAX_STEPS):
+            points = perception.target_points.astype(float)
+            centroid = points.mean(axis=0)
+            top = points[points[:, 2] > points[:, 2].max() - 0.01].mean(axis=0)
+            cmd = centroid_approach(centroid, self.settings.approach)
+            if cmd.done:
+                self.robot.drive(0.0, 0.0, 0.1)
+                self.robot.sleep(1.0)  # the ramp down; then look once more, at rest
+                return perceive(self.robot.capture(), point=top)
+            self.robot.drive(cmd.v, cmd.w, 0.5)
+            self.robot.sleep(APPROACH_PERIOD)
+            new_pose = self.robot.base_pose()
+            moved = invert(planar_pose(*new_pose)) @ planar_pose(*pose)
+            pose = new_pose
+            perception = perceive(self.robot.capture(), point=(moved @ np.append(top, 1.0))[:3])
+            if perception.segmentation is None:
+                self.robot.drive(0.0, 0.0, 0.1)
+                return Failure("detect_laser", "I lost sight of the object.")
+        self.robot.drive(0.0, 0.0, 0.1)
+        return Failure("execute", "The scooter did not reach the object.")
+

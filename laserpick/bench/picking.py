@@ -15,7 +15,7 @@ from laserpick.bench.operator import Referee, mark_and_capture
 from laserpick.description import dims
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasping import GraspSet, Strategy, find_grasps
-from laserpick.pipeline.perceive import perceive
+from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.sim_robot import SimRobot
 
@@ -44,7 +44,6 @@ class Attempt:
     failure: str | None = None  #: a FailureKind, when it did not succeed
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)  #: s per pipeline stage
-    marks: int = 0  #: how many times the operator marked it (re-marks after a failed mark)
 
     @property
     def decide_time(self) -> float:
@@ -61,6 +60,23 @@ def stow(robot: SimRobot, behaviours: Behaviours) -> None:
     out = behaviours.go_to(dims.UR5_HOME_Q, CollisionChecker(np.zeros((0, 3))), "stowing")
     if not out.ok:
         raise RuntimeError(f"the arm could not stow: {out.failure}")
+
+
+def mark_target(
+    robot: SimRobot, referee: Referee, instance: str, rng: np.random.Generator
+) -> Perception | Failure:
+    """The user marks `instance` and the robot perceives it. When the mark fails (the dot
+    missed, or no object under it), the user sees why and marks again, up to REMARKS times,
+    as 004's users re-aimed."""
+    aim = referee.aim_point(instance)
+    if aim is None:
+        return Failure("detect_laser", "no camera sees the object")
+    for _ in range(REMARKS + 1):
+        perception = perceive(mark_and_capture(robot, aim, rng))
+        if perception.ok:
+            return perception
+    assert perception.failure is not None
+    return perception.failure
 
 
 def mark_and_pick(
@@ -83,20 +99,11 @@ def mark_and_pick(
     names = [p.instance for p in placements]
     model = next(p.model.name for p in placements if p.instance == instance)
     rec = Attempt(instance, model)
-    aim = referee.aim_point(instance)
-    if aim is None:
-        rec.failure, rec.message = "detect_laser", "no camera sees the object"
+    perception = mark_target(robot, referee, instance, rng)
+    if isinstance(perception, Failure):
+        rec.failure, rec.message = perception.kind, perception.message
         return rec
-    # The user sees the failure and marks again, up to REMARKS times (004's users re-aimed).
-    for rec.marks in range(1, REMARKS + 2):
-        perception = perceive(mark_and_capture(robot, aim, rng))
-        if perception.ok:
-            break
     rec.timings.update(perception.timings)
-    if not perception.ok:
-        assert perception.failure is not None
-        rec.failure, rec.message = perception.failure.kind, perception.failure.message
-        return rec
     found = find_grasps(
         perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q, strategy=strategy, rng=rng
     )

@@ -43,14 +43,17 @@ def _link_capsules() -> tuple[tuple[Segment, ...], ...]:
 #: Capsules (from, to, radius) of each of the six links, in that link's body frame (m).
 LINK_CAPSULES: tuple[tuple[Segment, ...], ...] = _link_capsules()
 
-_FINGER_Y = dims.GRIPPER_STROKE / 2 + dims.GRIPPER_PAD_THICKNESS  # plate's inner face, open
-_FINGER_R = 0.015  # covers the plate (24 x 8 mm) and its pad
+_FINGER_Y = dims.GRIPPER_STROKE / 2 + dims.GRIPPER_PAD_THICKNESS  # pad/plate seam, open
+_FINGER_R = 0.010  # two capsules side by side cover the 24 x 16 mm plate-and-pad section
 _ROOT, _TIP = dims.GRIPPER_BASE_LENGTH, dims.GRIPPER_BASE_LENGTH + dims.GRIPPER_FINGER_LENGTH
 #: The gripper in the flange frame (m): its housing, and each open finger with its pad.
 GRIPPER_CAPSULES: tuple[Segment, ...] = (
     ((0, 0, 0.02), (0, 0, _ROOT - 0.01), 0.05),
-    ((0, _FINGER_Y, _ROOT + _FINGER_R), (0, _FINGER_Y, _TIP - _FINGER_R), _FINGER_R),
-    ((0, -_FINGER_Y, _ROOT + _FINGER_R), (0, -_FINGER_Y, _TIP - _FINGER_R), _FINGER_R),
+    *(
+        ((x, y, _ROOT + _FINGER_R), (x, y, _TIP - _FINGER_R), _FINGER_R)
+        for y in (_FINGER_Y, -_FINGER_Y)
+        for x in (-0.006, 0.006)
+    ),
 )
 
 

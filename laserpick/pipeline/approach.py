@@ -44,10 +44,14 @@ def centroid_approach(
     dx = float(centroid_base[0]) - s.grasp_spot[0]
     dy = float(centroid_base[1]) - s.grasp_spot[1]
     distance = math.hypot(dx, dy)
-    if distance <= s.tolerance:
+    near = distance <= s.near_distance
+    # Inside the near zone the bearing is not corrected (Kw = 0), so a sideways error there
+    # stays: the approach ends once the target is no longer ahead or behind, and the arm
+    # takes up the rest.
+    if distance <= s.tolerance or (near and abs(dx) <= s.tolerance):
         return DriveCommand(0.0, 0.0, True)
     # A target behind the spot means backing up: drive along the line, sign by dX.
     theta = math.atan2(dy, dx) if dx >= 0 else math.atan2(-dy, -dx)
-    v = math.copysign(min(s.kv * distance, s.v_max), dx)
+    v = math.copysign(min(s.kv * (abs(dx) if near else distance), s.v_max), dx)
     w = float(np.clip(bearing_gain(distance, s) * theta, -s.w_max, s.w_max))
     return DriveCommand(v, w, False)

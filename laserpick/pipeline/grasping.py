@@ -32,6 +32,7 @@ from laserpick.settings import Settings, get_settings
 Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
 VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
+VERTICAL_TOP_POINTS = 30  #: top points needed to centre a vertical grasp on the top face
 VERTICAL_SLACK = 0.005  #: m of the stroke left over a vertical grasp's width
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 
@@ -65,8 +66,13 @@ def vertical_grasp(
     target: np.ndarray, support: float | None, settings: Settings
 ) -> Grasp | Failure:
     """A top-down grasp at the centroid, closing across the narrow side, the pads reaching
-    2 cm below the top but stopping 3 mm above the support surface at `support` (m)."""
-    centre = target.mean(axis=0)
+    2 cm below the top but stopping 3 mm above the support surface at `support` (m).
+
+    The centroid is the top face's, when the cameras see enough of it: they look down on
+    the object from the front, so the mean of all its points lies toward them.
+    """
+    top = target[target[:, 2] > target[:, 2].max() - VERTICAL_BITE]
+    centre = (top if len(top) >= VERTICAL_TOP_POINTS else target).mean(axis=0)
     xy = target[:, :2] - centre[:2]
     _, vecs = np.linalg.eigh(np.cov(xy.T) if len(xy) > 2 else np.eye(2))
     closing = np.append(vecs[:, 0], 0.0)

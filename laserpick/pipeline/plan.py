@@ -197,10 +197,13 @@ def plan_pick(
     rng: np.random.Generator,
     settings: MotionSettings | None = None,
     via: np.ndarray | None = None,
+    check_hand: bool = True,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
     via: a configuration the transit passes through (the ready pose, from a stowed arm).
+    check_hand: check the hand at the grasp against the surroundings; grasp detection that
+    already tested the hand's exact shape there (GPD, EL-E's sweep) may skip it.
 
     world: the whole cloud; surroundings: the cloud less the target. The arm is checked
     against the world all the way. The hand is checked against the world on the transit; on
@@ -211,7 +214,9 @@ def plan_pick(
     lift only the arm is checked against the surroundings, as the hand rises from its grasp.
     """
     s = settings or get_settings().motion
-    if not surroundings.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]:
+    if check_hand and not surroundings.clearance_ok(
+        q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE
+    )[0]:
         return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
     T_pre = T_grasp.copy()
@@ -233,6 +238,8 @@ def plan_pick(
     if up is None or lift is None or not surroundings.clearance_ok(lift, hand=False).all():
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = None
+    if via is not None and not world.clearance_ok(via)[0]:
+        via = None  # the ready pose itself is in the way (a high table): plan around it
     legs = [q_now, q_pre] if via is None else [q_now, via, q_pre]
     for a, b in itertools.pairwise(legs):
         leg = joint_path(a, b, world, rng, s, hand=True)
