@@ -135,12 +135,29 @@ class Behaviours:
     def _q(self) -> np.ndarray:
         return self.robot.joint_state().q
 
-    def go_to(self, q_goal: np.ndarray, checker: CollisionChecker, what: str, **kw) -> Outcome:
-        """A collision-free joint move to q_goal (6,) rad."""
-        path = joint_path(self._q(), q_goal, checker, self.rng, self.settings.motion, **kw)
+    def go_to(
+        self,
+        q_goal: np.ndarray,
+        checker: CollisionChecker,
+        what: str,
+        via: Sequence[np.ndarray] = (),
+        **kw,
+    ) -> Outcome:
+        """A collision-free joint move to q_goal (6,) rad; when no path is found, through
+        each configuration of `via` in turn (two shorter searches instead of one long)."""
+        s, q = self.settings.motion, self._q()
+        path = joint_path(q, q_goal, checker, self.rng, s, **kw)
+        for q_via in via:
+            if path is not None:
+                break
+            first = joint_path(q, q_via, checker, self.rng, s, **kw)
+            second = (
+                joint_path(q_via, q_goal, checker, self.rng, s, **kw) if first is not None else None
+            )
+            path = None if second is None else np.vstack([first, second[1:]])
         if path is None:
             return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
-        return Outcome(self._run(timed(path, self.settings.motion), what))
+        return Outcome(self._run(timed(path, s), what))
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the ready pose, raised in front with the gripper down."""
@@ -160,8 +177,9 @@ class Behaviours:
         plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
         attempts = 0
         q_now = self._q()
-        # From a stowed arm, go through the ready pose: a known path out of the cameras' way.
-        via = None if np.max(np.abs(q_now - dims.UR5_READY_Q)) < 0.05 else dims.UR5_READY_Q
+        # From a stowed arm, go through a ready pose: a known path out of the cameras' way.
+        stowed = np.max(np.abs(q_now - dims.UR5_READY_Q)) > 0.05
+        via = (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q) if stowed else ()
         for grasp in order:
             attempts += 1
             assert grasp.ik is not None
@@ -271,7 +289,11 @@ class Behaviours:
             return Outcome(Failure("ik_plan", "The arm cannot reach over the basket."))
         self.progress("Carrying the object to the basket.")
         out = self.go_to(
-            q_drop, held.surroundings, "carrying to the basket", payload=held.points_tcp
+            q_drop,
+            held.surroundings,
+            "carrying to the basket",
+            via=(dims.UR5_HIGH_READY_Q,),
+            payload=held.points_tcp,
         )
         if not out.ok:
             return out
@@ -375,4 +397,3 @@ class Behaviours:
                 return Failure("detect_laser", "I lost sight of the object.")
         self.robot.drive(0.0, 0.0, 0.1)
         return Failure("execute", "The scooter did not reach the object.")
-

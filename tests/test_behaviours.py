@@ -11,6 +11,7 @@ from laserpick.behaviours import Behaviours
 from laserpick.bench.operator import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
@@ -20,6 +21,7 @@ from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Grasp
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
+from laserpick.transforms import matrix_from_quat
 
 TABLE_TOP = 0.46  # the isolation scene's table (m)
 
@@ -107,3 +109,39 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     robot.sleep(1.0)
     assert referee.in_basket(name)
     assert not robot.gripper_state().closed
+
+
+def test_picked_object_is_placed_upright_at_the_mark(robot):
+    referee = Referee(robot)
+    name = "mug_1"
+    perception = perceive(robot.capture(), point=referee.aim_point(name))
+    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+    assert isinstance(found, GraspSet), found
+    b = Behaviours(robot)
+    assert b.pick(found).ok
+    tcp = tcp_pose(robot.joint_state().q)[:3, 3]
+    offset = (referee.position(name) - tcp)[:2]
+    up0 = matrix_from_quat(referee.world_quat(name)).T @ [0.0, 0.0, 1.0]
+    # A free spot on the table, to the right of everything: the user's place mark.
+    mark = np.array([1.45, -0.55, TABLE_TOP])
+    frames = robot.capture()
+    out = b.place(fuse(frames), mark)
+    assert out.ok, out.failure
+    assert out.spot is not None and abs(out.spot[2] - TABLE_TOP) < 0.01
+    assert not robot.gripper_state().closed
+    robot.sleep(1.0)
+    error = np.linalg.norm(referee.position(name)[:2] - (out.spot[:2] + offset))
+    assert error < 0.03, f"{error * 100:.1f} cm from where it should stand"
+    up = matrix_from_quat(referee.world_quat(name)) @ up0
+    assert up[2] > np.cos(np.radians(15)), "it should stand as it stood"
+
+
+def test_place_on_a_non_surface_is_refused_and_keeps_the_object(robot):
+    referee = Referee(robot)
+    perception = perceive(robot.capture(), point=referee.aim_point("mug_1"))
+    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+    b = Behaviours(robot)
+    assert b.pick(found).ok
+    out = b.place(fuse(robot.capture()), np.array([1.5, -0.3, 1.2]))  # mid-air
+    assert out.failure is not None and out.failure.kind == "precondition"
+    assert robot.gripper_state().holding

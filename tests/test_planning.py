@@ -176,7 +176,7 @@ def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
     T = top_grasp(1.55, -0.25, 0.50, yaw=0.4)
     q_grasp = ik_tcp(T, dims.UR5_READY_Q)[0]
     plan = plan_pick(
-        dims.UR5_HOME_Q, q_grasp, world, world, np.random.default_rng(0), s, via=dims.UR5_READY_Q
+        dims.UR5_HOME_Q, q_grasp, world, world, np.random.default_rng(0), s, via=(dims.UR5_READY_Q,)
     )
     assert not isinstance(plan, Failure), plan
     assert np.allclose(plan.transit.q[0], dims.UR5_HOME_Q)

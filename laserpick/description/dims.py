@@ -54,6 +54,9 @@ UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
 #: in `base`: the transit pose between home and any grasp above the workspace. Far enough
 #: forward that the elbow clears the right sensor housings by 3 cm (rad).
 UR5_READY_Q = np.array([-0.308, -1.453, 1.299, 1.725, 1.571, 1.263])
+#: Like ready, 15 cm higher (TCP at about (1.45, -0.30, 1.00)): the transit pose over a
+#: high table, where the ready pose's hand would be among the objects (rad).
+UR5_HIGH_READY_Q = np.array([-0.36, -1.444, 0.877, 2.138, 1.571, 1.211])
 
 # --- Gripper (Robotiq 2F-85-like parallel jaw) ------------------------------------------------
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -196,12 +197,13 @@ def plan_pick(
     surroundings: CollisionChecker,
     rng: np.random.Generator,
     settings: MotionSettings | None = None,
-    via: np.ndarray | None = None,
+    via: Sequence[np.ndarray] = (),
     check_hand: bool = True,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
-    via: a configuration the transit passes through (the ready pose, from a stowed arm).
+    via: configurations the transit may pass through (the ready poses, from a stowed arm):
+    the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
     already tested the hand's exact shape there (GPD, EL-E's sweep) may skip it.
 
@@ -238,9 +240,8 @@ def plan_pick(
     if up is None or lift is None or not surroundings.clearance_ok(lift, hand=False).all():
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = None
-    if via is not None and not world.clearance_ok(via)[0]:
-        via = None  # the ready pose itself is in the way (a high table): plan around it
-    legs = [q_now, q_pre] if via is None else [q_now, via, q_pre]
+    clear = [q for q in via if world.clearance_ok(q)[0]]
+    legs = [q_now, clear[0], q_pre] if clear else [q_now, q_pre]
     for a, b in itertools.pairwise(legs):
         leg = joint_path(a, b, world, rng, s, hand=True)
         if leg is None:
