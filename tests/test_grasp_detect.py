@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from laserpick.pipeline import grasp_detect as gd
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.types import Grasp
 from laserpick.settings import GraspSettings
@@ -257,3 +258,107 @@ def test_same_seed_same_grasps():
 
 def test_tiny_target_gives_nothing():
     assert detect_grasps(np.zeros((2, 3)), np.zeros((2, 3)), table()) == []
+
+
+# --- fast paths against the direct computation ---------------------------------------------
+
+
+def local_setup(target: np.ndarray, normals: np.ndarray, n_samples: int, seed: int = 1):
+    """Samples, their frames, orientations and closing grid, as detect_grasps builds them."""
+    idx = gd.sample_indices(len(target), n_samples, np.random.default_rng(seed))
+    normal, axis = gd.local_frames(target, normals, idx, S)
+    return target[idx], normal, axis, gd.orientation_angles(S.gpd_orientations), gd.ClosingGrid(S)
+
+
+def test_pruned_tips_equal_the_direct_computation():
+    pts, n = cylinder()
+    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
+    cloud = np.vstack([table(), other, pts])
+    samples, normal, axis, angles, grid = local_setup(pts, noisy(n), 120)
+    regions = gd.hand_regions(S)
+    sid, _, h, u, v = gd.slab_pairs(cloud, samples, normal, axis, regions)
+    direct = gd.deepest_tips(h, u, v, sid, len(samples), angles, grid, S)
+    want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
+    pairs = gd.CoarsePairs(cloud, samples, normal, axis, regions)
+    pruned = gd.pruned_tips(pairs, samples, normal, axis, angles, grid, S, regions, want)
+    free = np.isfinite(direct) & want[:, :, None]
+    assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur
+    np.testing.assert_array_equal(np.isfinite(pruned), free)
+    np.testing.assert_allclose(pruned[free], direct[free], rtol=0, atol=1e-6)
+
+
+def test_antipodal_possible_never_rules_out_a_passing_frame():
+    pts, n = cylinder()
+    normals = noisy(n)
+    samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
+    sid, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
+    possible = gd.antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
+    rng = np.random.default_rng(3)
+    passed = np.zeros(len(possible), bool)
+    for _ in range(30):  # any placement, any depth the collision test could give
+        offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
+        tip = rng.uniform(S.gpd_init_bite, S.finger_length - S.gpd_clearance, len(possible))
+        _, ok = gd.closing_region(
+            u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
+        )
+        passed |= ok
+    assert passed.sum() > 50 and not possible.all()
+    assert not (passed & ~possible).any()
+
+
+def test_range_max_matches_a_direct_max():
+    rng = np.random.default_rng(0)
+    table_ = rng.normal(size=(37, 5)).astype(np.float32)
+    widest = 9
+    range_max = gd.RangeMax(table_, widest)
+    lo = rng.integers(0, 37, 2000)
+    hi = np.minimum(lo + rng.integers(0, widest, 2000), 36)
+    col = rng.integers(0, 5, 2000)
+    expected = [table_[a : b + 1, c].max() for a, b, c in zip(lo, hi, col, strict=True)]
+    np.testing.assert_array_equal(range_max(lo, hi, col), expected)
+
+
+def test_voxel_groups_hold_each_point_once_within_its_radius():
+    pts = np.random.default_rng(0).uniform(-0.1, 0.1, (5000, 3))
+    vox = gd.VoxelGroups(pts, 0.01)
+    parent, members = vox.members(np.arange(len(vox.starts)))
+    np.testing.assert_array_equal(np.sort(members), np.arange(len(pts)))
+    for axis in range(3):  # each group fits in one 1 cm cube
+        x = vox.points[members, axis]
+        span = np.maximum.reduceat(x, vox.starts) - np.minimum.reduceat(x, vox.starts)
+        assert span.max() < 0.01
+    spread = np.linalg.norm(vox.points[members] - vox.points[vox.rep[parent]], axis=1)
+    assert (spread <= vox.radius[parent]).all()
+
+
+def test_detector_equals_the_direct_computation():
+    # detect_grasps' shortcuts (the antipodal bound, voxel-pruned collisions, the cropped and
+    # de-duplicated scene) change nothing: the same grasps as deepest_tips over every frame
+    # and every (sample, scene point) pair, then the antipodal test.
+    s = GraspSettings(gpd_samples=200)
+    pts, n = cylinder()
+    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
+    normals, target = noisy(n), pts.astype(np.float32).astype(np.float64)
+    scene = np.vstack([table(), pts, other]).astype(np.float32)
+    fast = detect_grasps(target, normals, scene, s, np.random.default_rng(5))
+
+    centre = 0.5 * (target.min(axis=0) + target.max(axis=0))
+    tgt = target - centre
+    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(5))
+    normal, axis = gd.local_frames(tgt, normals, idx, s)
+    angles, grid = gd.orientation_angles(s.gpd_orientations), gd.ClosingGrid(s)
+    cloud = np.vstack([scene - centre, tgt])
+    sid, _, h, u, v = gd.slab_pairs(cloud, tgt[idx], normal, axis, gd.hand_regions(s))
+    tips = gd.deepest_tips(h, u, v, sid, len(idx), angles, grid, s).reshape(-1, len(grid.offsets))
+    has, k = gd.middle_placement(np.isfinite(tips))
+    offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
+    tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
+    tsid, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
+    width, ok = gd.closing_region(tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s)
+    good = np.flatnonzero(ok & has)
+    poses = gd.grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
+    poses[:, :3, 3] += centre
+
+    assert len(fast) == len(good) > 50
+    np.testing.assert_allclose([g.pose for g in fast], poses, rtol=0, atol=1e-6)
+    np.testing.assert_allclose([g.width for g in fast], width[good], rtol=0, atol=1e-6)
