@@ -216,9 +216,10 @@ def plan_pick(
     lift only the arm is checked against the surroundings, as the hand rises from its grasp.
     """
     s = settings or get_settings().motion
-    if check_hand and not surroundings.clearance_ok(
-        q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE
-    )[0]:
+    if (
+        check_hand
+        and not surroundings.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]
+    ):
         return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
     T_pre = T_grasp.copy()
