@@ -265,18 +265,30 @@ class Behaviours:
     def drop_configuration(
         self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
     ) -> np.ndarray | None:
-        """A clear joint configuration with the TCP over the basket's opening, the gripper
-        pointing down or tilted up to 30 deg, 10-16 cm above the rim; nearest q_ref wins.
+        """A clear joint configuration with the held object over the basket's opening: the
+        gripper pointing down or tilted up to 30 deg, 6-14 cm above the rim.
 
-        The basket sits close beside the arm's base, between the tiller, the sensor posts
-        and the projector, so few postures reach over it: they are searched, not assumed.
+        Postures that hold every point of the object inside the opening (1 cm in from the
+        walls) come first, then those that hold its middle there; nearest q_ref wins within
+        each. The basket sits close beside the arm's base, between the tiller, the sensor
+        posts and the projector, so few postures reach over it: they are searched, not
+        assumed.
         """
-        best = None
-        for q in drop_candidates():
+        lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
+        hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
+        best: tuple[int, float, np.ndarray] | None = None
+        candidates = np.array(drop_candidates())
+        clear = checker.clearance_ok(candidates, payload=payload)
+        T = tcp_pose(candidates[clear])
+        for q, T_q in zip(candidates[clear], T, strict=True):
+            xy = (payload @ T_q[:3, :3].T + T_q[:3, 3])[:, :2] if len(payload) else T_q[None, :2, 3]
+            inside = (xy >= lo) & (xy <= hi)
+            middle = xy.mean(axis=0)
+            rank = 0 if inside.all() else 1 if np.all((middle >= lo) & (middle <= hi)) else 2
             d = float(np.max(np.abs(q - q_ref)))
-            if (best is None or d < best[0]) and checker.clearance_ok(q, payload=payload)[0]:
-                best = (d, q)
-        return None if best is None else best[1]
+            if best is None or (rank, d) < best[:2]:
+                best = (rank, d, q)
+        return None if best is None else best[2]
 
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready."""
