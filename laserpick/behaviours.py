@@ -43,6 +43,8 @@ GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
 #: Seconds between the centroid approach's control steps (each re-perceives the target).
 APPROACH_PERIOD = 0.25
 APPROACH_MAX_STEPS = 240
+#: Highest extra lift (m) to bring a held object clear before carrying it.
+RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
@@ -290,6 +292,26 @@ class Behaviours:
                 best = (rank, d, q)
         return None if best is None else best[2]
 
+    def _rise_clear(self, held: Held) -> Failure | None:
+        """Lift straight up, 5 cm at a time and at most RISE_MAX, until the held object is
+        clear of the surroundings: just after the lift it may still be near its neighbours
+        or the parts of itself the segmentation missed, and a planner cannot start there."""
+        s = self.settings.motion
+        risen = 0.0
+        while not held.surroundings.clearance_ok(self._q(), payload=held.points_tcp)[0]:
+            if risen >= RISE_MAX:
+                return None  # let the planner say it found no way
+            T = tcp_pose(self._q())
+            T[2, 3] += 0.05
+            path = cartesian_line(self._q(), T, s.cartesian_step)
+            if path is None:
+                return None
+            failure = self._run(timed(path, s, tcp_speed=s.approach_speed), "lifting clear")
+            if failure is not None:
+                return failure
+            risen += 0.05
+        return None
+
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready."""
         if self.held is None or not self.robot.gripper_state().holding:
@@ -300,6 +322,9 @@ class Behaviours:
         if q_drop is None:
             return Outcome(Failure("ik_plan", "The arm cannot reach over the basket."))
         self.progress("Carrying the object to the basket.")
+        failure = self._rise_clear(held)
+        if failure is not None:
+            return Outcome(failure)
         out = self.go_to(
             q_drop,
             held.surroundings,

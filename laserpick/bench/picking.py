@@ -174,7 +174,7 @@ def run_scene(
     *,
     strategy: Strategy = "gpd",
     choose: str = "auto",
-    log=print,
+    log=lambda line: print(line, flush=True),
 ) -> list[Attempt]:
     """Pick-and-drop each instance in turn (in the given order) on a running scene."""
     behaviours = Behaviours(robot, rng=rng, progress=lambda _msg: None)
