@@ -126,9 +126,16 @@ def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
     sim.settle(1.0)
     h = sim.execute(_joint_path(q_grasp, q_lift, 0.3))
     assert sim.run_until(h, 10.0) == "done", h.message
+    sim.settle(0.5)
+    z_lifted = sim.snapshot().xpos[body][2]
     sim.settle(5.0)
 
     s = sim.snapshot()
     lifted = s.xpos[body][2] - z_rest
     assert s.holding, f"{name}: gripper reports empty (width {s.gripper_width * 1000:.1f} mm)"
-    assert lifted > 0.09, f"{name}: lifted only {lifted * 100:.1f} cm after 5 s"
+    # The object may settle a little in the pads as the lift takes its weight (a mug held by
+    # its rim sinks about 1.3 cm, depending on sub-millimetre differences of approach), but
+    # it must rise most of the 10 cm and then not slip at all while held.
+    assert lifted > 0.08, f"{name}: lifted only {lifted * 100:.1f} cm after 5 s"
+    drift = z_lifted - s.xpos[body][2]
+    assert drift < 0.002, f"{name}: slipped {drift * 1000:.1f} mm in the pads over 5 s"
