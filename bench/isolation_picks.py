@@ -45,6 +45,9 @@ def main() -> None:
     n = len(attempts)
     grasp_ok = np.mean([a.success for a in attempts])
     detected = np.mean([a.detected for a in attempts])
+    stuck = sum(a.stuck for a in attempts)
+    if stuck:
+        print(f"{stuck} times the arm found no way home after an attempt and was moved by hand")
     decide = [a.decide_time for a in attempts if "plan" in a.timings]
     print(
         f"\n{n} attempts: grasp success {grasp_ok:.1%} (004: 93.8 %),"

@@ -43,6 +43,8 @@ GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
 #: Seconds between the centroid approach's control steps (each re-perceives the target).
 APPROACH_PERIOD = 0.25
 APPROACH_MAX_STEPS = 240
+#: Beyond this x (m, `base`) the hand is over the workspace in front of the scooter.
+WORKSPACE_X = 1.25
 #: Highest extra lift (m) to bring a held object clear before carrying it.
 RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
@@ -162,10 +164,30 @@ class Behaviours:
         return Outcome(self._run(timed(path, s), what))
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
-        """To the ready pose, raised in front with the gripper down."""
-        return self.go_to(
-            dims.UR5_READY_Q, checker or CollisionChecker(np.zeros((0, 3))), "going to ready"
-        )
+        """To the ready pose, raised in front with the gripper down. Without a `checker`
+        (no fresh cloud), a hand below the ready height first rises straight up to it, so
+        that the move does not sweep it through what stands around it."""
+        if checker is None:
+            checker = CollisionChecker(np.zeros((0, 3)))
+            T = tcp_pose(self._q())
+            ready_z = tcp_pose(dims.UR5_READY_Q)[2, 3]
+            if T[2, 3] < ready_z - 0.01 and T[0, 3] > WORKSPACE_X:
+                T[2, 3] = ready_z
+                up = cartesian_line(self._q(), T, self.settings.motion.cartesian_step)
+                if up is not None:
+                    failure = self._run(timed(up, self.settings.motion), "rising")
+                    if failure is not None:
+                        return Outcome(failure)
+        return self.go_to(dims.UR5_READY_Q, checker, "going to ready", via=(dims.UR5_HIGH_READY_Q,))
+
+    def stow(self) -> Outcome:
+        """Fold the arm down beside the scooter, out of the cameras' view, through ready."""
+        if np.max(np.abs(self._q() - dims.UR5_HOME_Q)) < 0.05:
+            return Outcome()
+        out = self.go_ready()
+        if not out.ok:
+            return out
+        return self.go_to(dims.UR5_HOME_Q, CollisionChecker(np.zeros((0, 3))), "stowing")
 
     # --- pick ------------------------------------------------------------------------------
 

@@ -13,7 +13,6 @@ import numpy as np
 from laserpick.behaviours import Behaviours
 from laserpick.bench.operator import Referee, mark_and_capture
 from laserpick.description import dims
-from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasping import GraspSet, Strategy, find_grasps
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.types import Failure, Grasp
@@ -44,6 +43,7 @@ class Attempt:
     failure: str | None = None  #: a FailureKind, when it did not succeed
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)  #: s per pipeline stage
+    stuck: bool = False  #: the arm found no way home afterwards and was moved by hand
 
     @property
     def decide_time(self) -> float:
@@ -51,15 +51,29 @@ class Attempt:
         return sum(self.timings.get(k, 0.0) for k in ("detect", "filter", "select", "plan"))
 
 
-def stow(robot: SimRobot, behaviours: Behaviours) -> None:
-    """Empty the hand and fold the arm out of the cameras' view for the next capture."""
+def stow(robot: SimRobot, behaviours: Behaviours) -> Failure | None:
+    """Empty the hand and fold the arm out of the cameras' view for the next capture.
+
+    When the arm finds no way back, the experimenter moves it home by hand (the simulator
+    sets the joints), so that one stuck attempt does not end the experiment; the failure is
+    returned for the attempt's record.
+    """
     if robot.gripper_state().closed:
         robot.gripper(False)
         robot.sleep(1.0)
     behaviours.held = None
-    out = behaviours.go_to(dims.UR5_HOME_Q, CollisionChecker(np.zeros((0, 3))), "stowing")
-    if not out.ok:
-        raise RuntimeError(f"the arm could not stow: {out.failure}")
+    out = behaviours.stow()
+    if out.ok:
+        return None
+
+    def home(m, d) -> None:
+        d.qpos[robot.sim.info.arm_qpos] = dims.UR5_HOME_Q
+        d.qvel[robot.sim.info.arm_dof] = 0.0
+
+    robot.sim.call(home)
+    robot.sim.halt()
+    robot.sleep(0.5)
+    return Failure("execute", f"the arm could not return home ({out.failure})")
 
 
 def mark_target(
@@ -183,8 +197,11 @@ def run_scene(
     for name in instances:
         t0 = time.perf_counter()
         rec = pick_and_drop(robot, behaviours, referee, name, rng, strategy=strategy, choose=choose)
-        stow(robot, behaviours)
+        stuck = stow(robot, behaviours)
         verdict = "ok" if rec.success else f"{rec.failure}: {rec.message}"
+        if stuck is not None:
+            rec.stuck = True
+            verdict += f"; then {stuck.message}, moved home by hand"
         log(
             f"  {name:<22} {verdict}  (decide {rec.decide_time * 1000:.0f} ms,"
             f" wall {time.perf_counter() - t0:.1f} s)"
