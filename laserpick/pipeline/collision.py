@@ -123,11 +123,13 @@ def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.
 def obstacle_mask(
     points: np.ndarray, *, voxel: float = 0.01, q_self: np.ndarray | None = None
 ) -> np.ndarray:
-    """Mask (N,) of the points worth checking against: finite, within the arm's reach, one
+    """Mask (N,) of the points worth checking against: finite, within the arm's reach, above
+    the floor's clearance (no sphere goes lower: the floor itself is checked exactly), one
     per `voxel` (m; 0 keeps all), and not the arm itself at q_self (rad) if given."""
-    d = points - _SHOULDER
-    mask = np.all(np.isfinite(points), axis=1) & (np.einsum("ij,ij->i", d, d) < REACH**2)
-    idx = np.flatnonzero(mask)
+    d = np.asarray(points, np.float32) - _SHOULDER.astype(np.float32)
+    with np.errstate(invalid="ignore"):
+        mask = (np.einsum("ij,ij->i", d, d) < REACH**2) & (points[:, 2] > FLOOR_CLEARANCE)
+    idx = np.flatnonzero(mask)  # NaN compares false: non-finite points drop out here
     if voxel > 0:
         idx = idx[thin(points[idx], voxel)]
     if q_self is not None:

@@ -39,6 +39,31 @@ def pregrasp_pose(pose: np.ndarray, distance: float) -> np.ndarray:
     return out
 
 
+COLLIDES = "every arm posture for this grasp collides with something"
+
+
+Option = tuple[np.ndarray, np.ndarray] | None  #: (joint solution, grasp pose), None: collides
+
+
+def _clear_options(
+    options: list[list[Option]],
+    chosen: dict[int, Option],
+    checker: CollisionChecker,
+    failure: dict[int, str],
+) -> list[list[Option]]:
+    """Options from the second rank on, with None where the arm collides at the grasp."""
+    index = [(i, r) for i, o in enumerate(options) if i not in chosen for r in range(1, len(o))]
+    if not index:
+        return options
+    ok = checker.clearance_ok(np.array([options[i][r][0] for i, r in index]), hand=False)
+    out = [list(o) for o in options]
+    for (i, r), good in zip(index, ok, strict=True):
+        if not good:
+            out[i][r] = None
+            failure[i] = COLLIDES
+    return out
+
+
 def reachable(
     grasps: Sequence[Grasp],
     checker: CollisionChecker,
@@ -52,7 +77,7 @@ def reachable(
     its pose replaces the grasp's.
     """
     # Per grasp, its IK options (solution, pose), nearest q_ref first.
-    options: list[list[tuple[np.ndarray, np.ndarray]]] = []
+    options: list[list[Option]] = []
     failure: dict[int, str] = {}
     for i, g in enumerate(grasps):
         Q = ik_tcp(g.pose, q_ref)
@@ -65,12 +90,17 @@ def reachable(
         order = np.argsort(np.linalg.norm(Q_all - q_ref, axis=1), kind="stable")
         options.append([(Q_all[k], poses[k]) for k in order])
         failure[i] = "the arm cannot reach this grasp"
-    # Check rank by rank, so most grasps cost one pre-grasp IK and one collision test.
-    chosen: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    # Rank by rank, so that most grasps cost one pre-grasp IK and one batched collision test.
+    # The hand is not checked at the grasp (grasp detection did that). After the first rank,
+    # the arm at every remaining option is checked in one batch, before any more pre-grasps
+    # are solved.
+    chosen: dict[int, Option] = {}
     for rank in range(max((len(o) for o in options), default=0)):
+        if rank == 1:
+            options = _clear_options(options, chosen, checker, failure)
         todo, q_grasp, q_pre = [], [], []
         for i, o in enumerate(options):
-            if i in chosen or rank >= len(o):
+            if i in chosen or rank >= len(o) or o[rank] is None:
                 continue
             q, pose = o[rank]
             pre = ik_tcp(pregrasp_pose(pose, approach_distance), q)
@@ -82,13 +112,14 @@ def reachable(
                 failure[i] = "the arm cannot reach the pre-grasp pose behind this grasp"
         if not todo:
             continue
-        ok = checker.clearance_ok(np.array(q_grasp), hand=False)
-        ok &= checker.clearance_ok(np.array(q_pre), hand=True)
+        ok = checker.clearance_ok(np.array(q_pre), hand=True)
+        if rank == 0:
+            ok &= checker.clearance_ok(np.array(q_grasp), hand=False)
         for i, good in zip(todo, ok, strict=True):
             if good:
                 chosen[i] = options[i][rank]
             else:
-                failure[i] = "every arm posture for this grasp collides with something"
+                failure[i] = COLLIDES
     out = []
     for i, g in enumerate(grasps):
         if i in chosen:
