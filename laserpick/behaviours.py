@@ -45,6 +45,9 @@ APPROACH_PERIOD = 0.25
 APPROACH_MAX_STEPS = 240
 #: Beyond this x (m, `base`) the hand is over the workspace in front of the scooter.
 WORKSPACE_X = 1.25
+#: TCP heights (m) over the basket's rim to release at: low for short objects (they should
+#: not bounce out), high for tall ones (they must clear the basket's floor).
+DROP_HEIGHTS = (-0.04, 0.0, 0.04, 0.08, 0.12, 0.18, 0.26)
 #: Highest extra lift (m) to bring a held object clear before carrying it.
 RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
@@ -83,8 +86,8 @@ class Held:
 
 @functools.cache
 def drop_candidates() -> tuple[np.ndarray, ...]:
-    """Joint configurations that put the TCP over the basket's opening, the arm clear of the
-    scooter (rad). Computed once: the basket is fixed to the scooter."""
+    """Joint configurations that put the TCP over (or just inside) the basket's opening, the
+    arm clear of the scooter (rad). Computed once: the basket is fixed to the scooter."""
     centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
     rim = centre[2] + inner[2] / 2
     free = CollisionChecker(np.zeros((0, 3)))
@@ -92,7 +95,7 @@ def drop_candidates() -> tuple[np.ndarray, ...]:
     for dx, dy, dz, yaw, tilt in itertools.product(
         np.linspace(-0.3, 0.3, 3) * inner[0],
         np.linspace(-0.3, 0.3, 3) * inner[1],
-        (0.06, 0.10, 0.14),
+        DROP_HEIGHTS,
         np.radians(np.arange(0, 180, 30)),
         np.radians((0, 15, 30)),
     ):
@@ -290,29 +293,33 @@ class Behaviours:
         self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
     ) -> np.ndarray | None:
         """A clear joint configuration with the held object over the basket's opening: the
-        gripper pointing down or tilted up to 30 deg, 6-14 cm above the rim.
+        gripper pointing down or tilted up to 30 deg, its TCP at one of DROP_HEIGHTS.
 
         Postures that hold every point of the object inside the opening (1 cm in from the
-        walls) come first, then those that hold its middle there; nearest q_ref wins within
-        each. The basket sits close beside the arm's base, between the tiller, the sensor
-        posts and the projector, so few postures reach over it: they are searched, not
-        assumed.
+        walls) come first, then those that hold its middle there; then the shortest fall
+        (in 5 cm steps); then the nearest to q_ref. The basket sits close beside the arm's
+        base, between the tiller, the sensor posts and the projector, so few postures reach
+        over it: they are searched, not assumed.
         """
         lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
         hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
-        best: tuple[int, float, np.ndarray] | None = None
+        floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+        best: tuple[tuple[int, int, float], np.ndarray] | None = None
         candidates = np.array(drop_candidates())
         clear = checker.clearance_ok(candidates, payload=payload)
         T = tcp_pose(candidates[clear])
         for q, T_q in zip(candidates[clear], T, strict=True):
-            xy = (payload @ T_q[:3, :3].T + T_q[:3, 3])[:, :2] if len(payload) else T_q[None, :2, 3]
-            inside = (xy >= lo) & (xy <= hi)
+            pts = payload @ T_q[:3, :3].T + T_q[:3, 3] if len(payload) else T_q[None, :3, 3]
+            xy = pts[:, :2]
             middle = xy.mean(axis=0)
-            rank = 0 if inside.all() else 1 if np.all((middle >= lo) & (middle <= hi)) else 2
-            d = float(np.max(np.abs(q - q_ref)))
-            if best is None or (rank, d) < best[:2]:
-                best = (rank, d, q)
-        return None if best is None else best[2]
+            inside = 0 if np.all((xy >= lo) & (xy <= hi)) else 1
+            if inside and not np.all((middle >= lo) & (middle <= hi)):
+                inside = 2
+            fall = round((pts[:, 2].min() - floor) / 0.05)  # in 5 cm steps: lower is gentler
+            key = (inside, fall, float(np.max(np.abs(q - q_ref))))
+            if best is None or key < best[0]:
+                best = (key, q)
+        return None if best is None else best[1]
 
     def _rise_clear(self, held: Held) -> Failure | None:
         """Lift straight up, 5 cm at a time and at most RISE_MAX, until the held object is
