@@ -27,7 +27,7 @@ MODELS = [
     for m in yaml.safe_load((SCENE_DIR / "isolation.yaml").read_text())["random"][0]["models"]
     if m != "cereal_box"
 ]
-GAP = (0.005, 0.02)  #: m between the two objects, drawn uniformly ("next to each other")
+GAP = (0.0, 0.01)  #: m between the two objects, drawn uniformly: touching to 1 cm apart
 FIRST_XY = np.array([1.50, -0.36])  #: m, world: the first object, in front of the arm
 
 SCENE = """
