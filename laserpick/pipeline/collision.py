@@ -73,6 +73,8 @@ def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarr
 #: The arm's reach from its shoulder, with the open hand (m): obstacles beyond cannot matter.
 REACH = 1.15
 _SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + 0.089])
+#: Points this close (m) to a keep-out box are taken to be the scooter seen by its cameras.
+SELF_PADDING = 0.02
 #: Largest voxel table `thin` allocates (entries of 4 bytes).
 DENSE_VOXELS_MAX = 16_000_000
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
@@ -125,7 +127,8 @@ def obstacle_mask(
 ) -> np.ndarray:
     """Mask (N,) of the points worth checking against: finite, within the arm's reach, above
     the floor's clearance (no sphere goes lower: the floor itself is checked exactly), one
-    per `voxel` (m; 0 keeps all), and not the arm itself at q_self (rad) if given."""
+    per `voxel` (m; 0 keeps all), not the arm itself at q_self (rad) if given, and not the
+    scooter (inside its keep-out boxes, which the checker tests exactly)."""
     d = np.asarray(points, np.float32) - _SHOULDER.astype(np.float32)
     with np.errstate(invalid="ignore"):
         mask = (np.einsum("ij,ij->i", d, d) < REACH**2) & (points[:, 2] > FLOOR_CLEARANCE)
@@ -134,6 +137,10 @@ def obstacle_mask(
         idx = idx[thin(points[idx], voxel)]
     if q_self is not None:
         idx = idx[self_filter(points[idx], q_self)]
+    # The scooter and its rider, where the cameras see them, are the keep-out boxes already.
+    p = np.asarray(points[idx], float)[:, None, :]
+    inside = np.all((p >= _LO - SELF_PADDING) & (p <= _HI + SELF_PADDING), axis=2).any(axis=1)
+    idx = idx[~inside]
     out = np.zeros(len(points), bool)
     out[idx] = True
     return out
