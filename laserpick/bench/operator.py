@@ -173,6 +173,14 @@ def drive_to(robot: SimRobot, goal: np.ndarray, *, reverse_first: float = 0.0) -
     return bool(np.linalg.norm(p[:2] - goal[:2]) < 0.03 and abs(_wrap(p[2] - goal[2])) < 0.035)
 
 
+def creep(robot: SimRobot, distance: float, speed: float = 0.2) -> None:
+    """Drive straight ahead `distance` m at `speed` m/s, as a user pulls up to a table."""
+    start = robot.base_pose()[:2].copy()
+    _drive_loop(
+        robot, lambda p: (speed, 0.0, bool(np.linalg.norm(p[:2] - start) >= distance - 0.005))
+    )
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
