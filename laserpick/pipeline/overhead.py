@@ -22,6 +22,7 @@ from laserpick.settings import GraspSettings, get_settings
 GRID_CELL = 0.01  #: m, EL-E's 2D occupancy grid resolution (000 section 4.4.1)
 RAISED_BAND = 0.005  #: m, "less than 5 mm below the point of maximum height" (000 4.4.2)
 GRASP_DEPTH = 0.02  #: m the pads reach below the top of the object (our choice)
+FLOOR_GAP = 0.003  #: m the fingertips stay above the support surface
 
 
 def occupancy_pca(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -79,9 +80,12 @@ def overhead_grasp(
         if np.linalg.norm(closing) < 1e-6:
             closing = minor
         width = min(s.width_max, _extent(target[:, :2], closing / np.linalg.norm(closing)))
-    z = max(surface_height + 0.012, top - GRASP_DEPTH)
+    # The TCP is pad_depth / 2 above the fingertips, which stop FLOOR_GAP above the support.
+    z = max(surface_height + FLOOR_GAP + s.pad_depth / 2, top - GRASP_DEPTH)
     pose = _pose(np.array([xy[0], xy[1], z]), closing)
-    blocked = sweep_collisions(pose, scene, target, s)
+    # The support itself is below the fingertips: its points (and their noise) do not block.
+    above = scene[scene[:, 2] > surface_height + FLOOR_GAP]
+    blocked = sweep_collisions(pose, above, target, s)
     if blocked:
         return Failure(
             "detect_grasp", f"an overhead grasp would hit {blocked} points on the way down"
