@@ -134,8 +134,7 @@ class Behaviours:
         if status == "done":
             return None
         if status == "running":
-            self.robot.stop()
-            self.robot.reset_stop()
+            self.robot.halt()  # not the latching e-stop: that one stays the user's
             return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
         return Failure("execute", f"The arm stopped while {what}: {handle.message}.")
 
@@ -204,9 +203,9 @@ class Behaviours:
         plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
         attempts = 0
         q_now = self._q()
-        # From a stowed arm, go through a ready pose: a known path out of the cameras' way.
-        stowed = np.max(np.abs(q_now - dims.UR5_READY_Q)) > 0.05
-        via = (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q) if stowed else ()
+        # From anywhere but ready (stowed, mostly), go through a ready pose: a known path.
+        at_ready = np.max(np.abs(q_now - dims.UR5_READY_Q)) < 0.05
+        via = () if at_ready else (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q)
         for grasp in order:
             attempts += 1
             assert grasp.ik is not None
@@ -235,10 +234,12 @@ class Behaviours:
             plan.approach.times, plan.approach.q, plan.approach.gripper, guard_force=s.guard_force
         )
         failure = self._run(guarded, "approaching the object")
-        if failure:
+        if failure and "unexpected contact" in failure.message:
             self._back_off()
             msg = "The hand touched something on its way in, stopped and backed off."
             return Outcome(Failure("execute", msg), grasp, attempts, timings)
+        if failure:
+            return Outcome(failure, grasp, attempts, timings)
         self.progress("Closing the gripper.")
         self.robot.gripper(True)
         self.robot.sleep(GRIPPER_TIME)

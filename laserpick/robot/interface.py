@@ -71,6 +71,10 @@ class Robot(Protocol):
         """Drive at v (m/s) and w (rad/s) for at most `duration` s (a dead-man command)."""
         ...
 
+    def halt(self) -> None:
+        """Stop the arm and the base now, without latching (a cancelled or overdue motion)."""
+        ...
+
     def stop(self) -> None:
         """E-stop: arm and base halt now and stay halted until `reset_stop`."""
         ...

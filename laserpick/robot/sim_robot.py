@@ -105,6 +105,9 @@ class SimRobot:
     def drive(self, v: float, w: float, duration: float = 0.5) -> None:
         self.sim.drive(v, w, duration)
 
+    def halt(self) -> None:
+        self.sim.halt()
+
     def stop(self) -> None:
         self.sim.stop()
 
