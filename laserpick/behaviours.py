@@ -45,9 +45,8 @@ APPROACH_PERIOD = 0.25
 APPROACH_MAX_STEPS = 240
 #: Beyond this x (m, `base`) the hand is over the workspace in front of the scooter.
 WORKSPACE_X = 1.25
-#: TCP heights (m) over the basket's rim to release at: low for short objects (they should
-#: not bounce out), high for tall ones (they must clear the basket's floor).
-DROP_HEIGHTS = (-0.04, 0.0, 0.04, 0.08, 0.12, 0.18, 0.26)
+#: TCP heights (m) over the basket's rim to release at.
+DROP_HEIGHTS = (0.06, 0.10, 0.14)
 #: Highest extra lift (m) to bring a held object clear before carrying it.
 RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
@@ -163,7 +162,9 @@ class Behaviours:
             path = None if second is None else np.vstack([first, second[1:]])
         if path is None:
             return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
-        return Outcome(self._run(timed(path, s), what))
+        carrying = kw.get("payload") is not None
+        speed = s.carry_joint_speed if carrying else None
+        return Outcome(self._run(timed(path, s, joint_speed=speed), what))
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the ready pose, raised in front with the gripper down. Without a `checker`
@@ -297,15 +298,13 @@ class Behaviours:
         gripper pointing down or tilted up to 30 deg, its TCP at one of DROP_HEIGHTS.
 
         Postures that hold every point of the object inside the opening (1 cm in from the
-        walls) come first, then those that hold its middle there; then the shortest fall
-        (in 5 cm steps); then the nearest to q_ref. The basket sits close beside the arm's
-        base, between the tiller, the sensor posts and the projector, so few postures reach
-        over it: they are searched, not assumed.
+        walls) come first, then those that hold its middle there; then the nearest to q_ref.
+        The basket sits close beside the arm's base, between the tiller, the sensor posts and
+        the projector, so few postures reach over it: they are searched, not assumed.
         """
         lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
         hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
-        floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
-        best: tuple[tuple[int, int, float], np.ndarray] | None = None
+        best: tuple[tuple[int, float], np.ndarray] | None = None
         candidates = np.array(drop_candidates())
         clear = checker.clearance_ok(candidates, payload=payload)
         T = tcp_pose(candidates[clear])
@@ -316,8 +315,7 @@ class Behaviours:
             inside = 0 if np.all((xy >= lo) & (xy <= hi)) else 1
             if inside and not np.all((middle >= lo) & (middle <= hi)):
                 inside = 2
-            fall = round((pts[:, 2].min() - floor) / 0.05)  # in 5 cm steps: lower is gentler
-            key = (inside, fall, float(np.max(np.abs(q - q_ref))))
+            key = (inside, float(np.max(np.abs(q - q_ref))))
             if best is None or key < best[0]:
                 best = (key, q)
         return None if best is None else best[1]

@@ -446,6 +446,13 @@ class MotionSettings(BaseModel):
     )
     joint_accel: float = Field(1.5, gt=0, le=3.0, description="Joint acceleration (rad/s^2).")
     tcp_speed: float = Field(0.25, gt=0, description="TCP speed limit near people (m/s).")
+    carry_joint_speed: float = Field(
+        0.5,
+        gt=0,
+        le=3.14,
+        description="Joint speed limit (rad/s) while carrying an object: a swinging object"
+        " held by a rim or an edge turns in the pads. Ours.",
+    )
     approach_speed: float = Field(
         0.08, gt=0, description="TCP speed (m/s) on the last, guarded approach to a grasp. Ours."
     )

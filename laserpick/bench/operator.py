@@ -109,11 +109,12 @@ class Referee:
         return best
 
     def in_basket(self, instance: str) -> bool:
-        """Whether the object's centre lies inside the basket's walls."""
+        """Whether the object's origin lies inside the basket: within its walls, above its
+        floor and below its rim (with a little slack for a tall object leaning there)."""
         p = self.position(instance)
         lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
         hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
-        return bool(np.all(p[:2] >= lo[:2]) and np.all(p[:2] <= hi[:2]) and p[2] <= hi[2] + 0.05)
+        return bool(np.all(p >= lo - [0.0, 0.0, 0.02]) and np.all(p <= hi + [0.0, 0.0, 0.05]))
 
     def aim_point(self, instance: str) -> np.ndarray | None:
         """Where a person would aim: the middle of the object's visible top (m, `base`), from

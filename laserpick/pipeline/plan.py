@@ -160,12 +160,14 @@ def timed(
     s: MotionSettings,
     *,
     tcp_speed: float | None = None,
+    joint_speed: float | None = None,
     gripper: tuple[tuple[int, str], ...] = (),
 ) -> Trajectory:
-    """Time-parametrize a joint path within the motion limits (TCP speed capped near people)."""
+    """Time-parametrize a joint path within the motion limits (TCP speed capped near people;
+    `joint_speed` (rad/s) lowers the joint limit, e.g. while carrying)."""
     return time_parametrize(
         path,
-        v_max=s.joint_speed,
+        v_max=min(joint_speed or s.joint_speed, s.joint_speed),
         a_max=s.joint_accel,
         tcp=tcp_pose(path)[:, :3, 3],
         tcp_speed=tcp_speed or s.tcp_speed,
