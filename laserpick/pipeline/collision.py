@@ -22,7 +22,7 @@ from laserpick.description.collision import (
     Segment,
     body_frames,
 )
-from laserpick.description.dims import ARM_MOUNT_POS
+from laserpick.description.dims import ARM_MOUNT_POS, UR5_D
 from laserpick.description.kinematics import T_FLANGE_TCP
 
 
@@ -72,7 +72,7 @@ def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarr
 
 #: The arm's reach from its shoulder, with the open hand (m): obstacles beyond cannot matter.
 REACH = 1.15
-_SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + 0.089])
+_SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + UR5_D[0]])
 #: Points this close (m) to a keep-out box are taken to be the scooter seen by its cameras.
 SELF_PADDING = 0.02
 #: Largest voxel table `thin` allocates (entries of 4 bytes).

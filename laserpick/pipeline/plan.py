@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -37,8 +38,6 @@ HAND_CONTACT_TOLERANCE = 0.004
 
 def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
     """Pose a fraction s of the way from Ta to Tb: linear in position, slerp in rotation."""
-    from scipy.spatial.transform import Rotation, Slerp
-
     rots = Rotation.from_matrix(np.stack([Ta[:3, :3], Tb[:3, :3]]))
     T = np.eye(4)
     T[:3, :3] = Slerp([0.0, 1.0], rots)(s).as_matrix()
