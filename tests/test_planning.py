@@ -93,7 +93,7 @@ def test_thin_keeps_one_point_per_voxel():
     rng = np.random.default_rng(0)
     pts = rng.uniform(0, 0.2, (5000, 3))
     keep = thin(pts, 0.05)
-    cells = np.floor((pts - pts.min(axis=0)) / 0.05).astype(int)
+    cells = np.floor(pts.astype(np.float32) / np.float32(0.05)).astype(int)
     assert keep.sum() == len(np.unique(cells, axis=0))
     assert len(np.unique(cells[keep], axis=0)) == keep.sum()
 

@@ -134,22 +134,38 @@ def fuse(frames: Sequence[DepthFrame], settings: PerceptionSettings | None = Non
     return cloud
 
 
-def voxel_downsample(cloud: FusedCloud, size: float) -> FusedCloud:
-    """Keep the first point (in cloud order) of each occupied voxel of edge `size` (m).
+#: Largest voxel table `voxel_first` allocates (int64 entries); bigger boxes sort instead.
+DENSE_VOXELS_MAX = 16_000_000
 
-    The three integer voxel coordinates are packed into one int64 key (21 bits each), so
-    np.unique sorts numbers rather than rows; within the workspace that is exact for voxels
-    down to 1e-6 m.
+
+def voxel_first(points: np.ndarray, size: float) -> np.ndarray:
+    """Sorted indices of the first point (in array order) of each occupied voxel of edge
+    `size` (m), voxels aligned on multiples of `size`.
+
+    The three integer voxel coordinates are packed into one int64 key. Over a box of up to
+    DENSE_VOXELS_MAX voxels a table indexed by key takes each voxel's smallest point index
+    in linear time (a sort-based unique is several times slower on a full cloud); beyond
+    it, np.unique sorts the keys.
     """
-    if len(cloud) == 0:
-        return cloud
-    keys = np.floor(cloud.points / np.float32(size)).astype(np.int64)
+    n = len(points)
+    if n == 0:
+        return np.zeros(0, np.int64)
+    keys = np.floor(np.asarray(points, np.float32) / np.float32(size)).astype(np.int64)
     keys -= keys.min(axis=0)
-    span = keys.max(axis=0)
-    if np.any(span >= 1 << 21):
-        # Too many voxels to pack: fall back to sorting rows.
+    span = keys.max(axis=0) + 1
+    packed = (keys[:, 0] * span[1] + keys[:, 1]) * span[2] + keys[:, 2]
+    cells = int(np.prod(span))
+    if cells <= DENSE_VOXELS_MAX:
+        table = np.full(cells, n, np.int64)
+        np.minimum.at(table, packed, np.arange(n, dtype=np.int64))
+        return np.sort(table[table < n])
+    if np.any(span >= 1 << 21):  # the packed key could overflow: sort rows
         _, first = np.unique(keys, axis=0, return_index=True)
     else:
-        packed = (keys[:, 0] << 42) | (keys[:, 1] << 21) | keys[:, 2]
         _, first = np.unique(packed, return_index=True)
-    return cloud.subset(np.sort(first))
+    return np.sort(first)
+
+
+def voxel_downsample(cloud: FusedCloud, size: float) -> FusedCloud:
+    """Keep the first point (in cloud order) of each occupied voxel of edge `size` (m)."""
+    return cloud.subset(voxel_first(cloud.points, size))

@@ -24,6 +24,7 @@ from laserpick.description.collision import (
 )
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_D
 from laserpick.description.kinematics import T_FLANGE_TCP
+from laserpick.pipeline.cloud import voxel_first
 
 
 @dataclass(frozen=True)
@@ -75,8 +76,6 @@ REACH = 1.15
 _SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + UR5_D[0]])
 #: Points this close (m) to a keep-out box are taken to be the scooter seen by its cameras.
 SELF_PADDING = 0.02
-#: Largest voxel table `thin` allocates (entries of 4 bytes).
-DENSE_VOXELS_MAX = 16_000_000
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
 PAYLOAD_POINT_RADIUS = 0.01
 #: A held object is checked against the arm's bodies up to this one (3: wrist 1).
@@ -84,25 +83,9 @@ PAYLOAD_CLEAR_OF_BODY = 3
 
 
 def thin(points: np.ndarray, voxel: float) -> np.ndarray:
-    """Mask of one point per occupied voxel of edge `voxel` (m).
-
-    Voxels are keyed by one integer; a dense table over the points' bounding box picks a
-    representative per key in linear time (a sort-based unique is 10x slower here), unless
-    the box is too large for the table.
-    """
+    """Mask of one point (the first) per occupied voxel of edge `voxel` (m)."""
     keep = np.zeros(len(points), bool)
-    if len(points) == 0:
-        return keep
-    p = np.asarray(points, np.float32)
-    k = ((p - p.min(axis=0)) * np.float32(1.0 / voxel)).astype(np.int64)  # >= 0: floor
-    span = k.max(axis=0) + 1
-    key = (k[:, 0] * span[1] + k[:, 1]) * span[2] + k[:, 2]
-    if int(np.prod(span)) <= DENSE_VOXELS_MAX:
-        table = np.full(int(np.prod(span)), -1, np.int32)
-        table[key] = np.arange(len(key), dtype=np.int32)  # one of the points in each voxel
-        keep[table[table >= 0]] = True
-    else:
-        keep[np.unique(key, return_index=True)[1]] = True
+    keep[voxel_first(points, voxel)] = True
     return keep
 
 

@@ -44,6 +44,7 @@ from collections.abc import Iterator
 import numpy as np
 from scipy.spatial import cKDTree
 
+from laserpick.pipeline.cloud import voxel_first
 from laserpick.pipeline.types import Grasp
 from laserpick.settings import GraspSettings, get_settings
 
@@ -122,11 +123,9 @@ def crop_ball(points: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarr
 
 def voxel_thin(points: np.ndarray, voxel: float) -> np.ndarray:
     """One point (the first) per occupied voxel of edge `voxel` (m); all points if 0."""
-    if voxel <= 0 or len(points) == 0:
+    if voxel <= 0:
         return points
-    keys = np.floor(points / voxel).astype(np.int64)
-    _, first = np.unique(keys, axis=0, return_index=True)
-    return points[np.sort(first)]
+    return points[voxel_first(points, voxel)]
 
 
 def copies_of(points: np.ndarray, target: np.ndarray, tree: cKDTree) -> np.ndarray:
