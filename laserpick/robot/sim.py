@@ -106,6 +106,7 @@ class Simulation:
         self.data = mujoco.MjData(self.model)
         self.info = ModelInfo.of(self.model)
         self._arm_geoms = frozenset(self.info.arm_geoms.tolist())
+        self._pad_geoms = frozenset(self.info.pad_geoms.tolist())
         self.arm_model = build_arm_model()
         self._cartesian = CartesianController(self.arm_model)
         self.dt = float(self.model.opt.timestep)
@@ -451,29 +452,26 @@ class Simulation:
             return True
         return False
 
-    def _gripper_force(self) -> float:
-        d, pads = self.data, self.info.pad_geoms
+    def _contact_force(self, geoms: frozenset[int]) -> float:
+        """Summed normal force (N) of the contacts that touch any of `geoms`."""
+        d = self.data
         total = 0.0
         force = np.zeros(6)
         for i in range(d.ncon):
             c = d.contact[i]
-            if c.geom1 in pads or c.geom2 in pads:
+            if c.geom1 in geoms or c.geom2 in geoms:
                 mujoco.mj_contactForce(self.model, d, i, force)
                 total += abs(force[0])
         return total
 
+    def _gripper_force(self) -> float:
+        """Force (N) on the pads: what the gripper's own current sensing reports."""
+        return self._contact_force(self._pad_geoms)
+
     def _arm_contact_force(self) -> float:
-        """Summed normal force (N) of the contacts on the arm and the gripper: what the UR5's
-        joint-current force estimate or a wrist force sensor would read."""
-        d, arm = self.data, self._arm_geoms
-        total = 0.0
-        force = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            if c.geom1 in arm or c.geom2 in arm:
-                mujoco.mj_contactForce(self.model, d, i, force)
-                total += abs(force[0])
-        return total
+        """Force (N) on the arm and the gripper: what the UR5's joint-current force estimate
+        or a wrist force sensor would read."""
+        return self._contact_force(self._arm_geoms)
 
     def _publish(self) -> None:
         d, info = self.data, self.info
