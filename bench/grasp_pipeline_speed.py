@@ -19,9 +19,8 @@ import numpy as np
 from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasping import GraspSet, find_grasps, plan_first
 from laserpick.pipeline.perceive import perceive
-from laserpick.pipeline.plan import plan_pick
 from laserpick.pipeline.types import Failure
 
 STAGES = ("detect", "filter", "select", "plan")
@@ -78,19 +77,7 @@ def main() -> None:
 def time_planning(found: GraspSet, q_now: np.ndarray, rng: np.random.Generator) -> float:
     """Seconds to plan grasps in score order until one plans (as `Behaviours.pick` does)."""
     t0 = time.perf_counter()
-    for grasp in found.ordered():
-        assert grasp.ik is not None
-        plan = plan_pick(
-            q_now,
-            grasp.ik,
-            found.world,
-            found.surroundings,
-            rng,
-            via=(dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q),
-            check_hand=found.strategy == "vertical",
-        )
-        if not isinstance(plan, Failure):
-            break
+    plan_first(found, q_now, rng)
     return time.perf_counter() - t0
 
 

@@ -26,9 +26,9 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.collision import CollisionChecker, thin
-from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.grasping import GraspSet, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
-from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, plan_pick, timed
+from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.surface import place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
@@ -201,27 +201,7 @@ class Behaviours:
             return Outcome(Failure("precondition", "The hand is already holding something."))
         order = list(order) if order is not None else grasps.ordered()
         t0 = time.perf_counter()
-        plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
-        attempts = 0
-        q_now = self._q()
-        # From anywhere but ready (stowed, mostly), go through a ready pose: a known path.
-        at_ready = np.max(np.abs(q_now - dims.UR5_READY_Q)) < 0.05
-        via = () if at_ready else (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q)
-        for grasp in order:
-            attempts += 1
-            assert grasp.ik is not None
-            plan = plan_pick(
-                q_now,
-                grasp.ik,
-                grasps.world,
-                grasps.surroundings,
-                self.rng,
-                s,
-                via=via,
-                check_hand=grasps.strategy == "vertical",  # the others checked the hand
-            )
-            if not isinstance(plan, Failure):
-                break
+        plan, grasp, attempts = plan_first(grasps, self._q(), self.rng, order, s)
         timings = {"plan": time.perf_counter() - t0}
         if isinstance(plan, Failure):
             msg = f"None of the {attempts} grasps could be planned ({plan.message})"

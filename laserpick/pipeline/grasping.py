@@ -14,20 +14,22 @@ clustered by position. Each stage is timed. Frames: `base`, metres, radians.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
-from laserpick.description.dims import ARM_MOUNT_POS
+from laserpick.description.dims import ARM_MOUNT_POS, UR5_HIGH_READY_Q, UR5_READY_Q
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.plan import PickPlan, plan_pick
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.selection import GraspClusters, group, score
 from laserpick.pipeline.types import Failure, Grasp
-from laserpick.settings import Settings, get_settings
+from laserpick.settings import MotionSettings, Settings, get_settings
 
 Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
@@ -35,6 +37,7 @@ VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
 VERTICAL_TOP_POINTS = 30  #: top points needed to centre a vertical grasp on the top face
 VERTICAL_SLACK = 0.005  #: m of the stroke left over a vertical grasp's width
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
+READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready pose within this
 
 
 @dataclass(frozen=True)
@@ -176,3 +179,40 @@ def find_grasps(
     clusters = group(scored, s.grasp)
     timings["select"] = time.perf_counter() - t0
     return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings)
+
+
+def plan_first(
+    found: GraspSet,
+    q_now: np.ndarray,
+    rng: np.random.Generator,
+    order: Sequence[Grasp] | None = None,
+    settings: MotionSettings | None = None,
+) -> tuple[PickPlan | Failure, Grasp | None, int]:
+    """Plan the grasps of `order` (default: all, best first) until one plans, as 004 does.
+
+    From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose.
+    The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
+    it there already. Returns the plan (or the last failure), its grasp and how many grasps
+    were tried.
+    """
+    at_ready = np.max(np.abs(q_now - UR5_READY_Q)) < READY_TOLERANCE
+    via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
+    plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
+    tried = 0
+    for grasp in found.ordered() if order is None else order:
+        tried += 1
+        if grasp.ik is None:
+            raise ValueError("plan_first needs grasps from the reachability filter")
+        plan = plan_pick(
+            q_now,
+            grasp.ik,
+            found.world,
+            found.surroundings,
+            rng,
+            settings,
+            via=via,
+            check_hand=found.strategy == "vertical",
+        )
+        if not isinstance(plan, Failure):
+            return plan, grasp, tried
+    return plan, None, tried
