@@ -16,7 +16,7 @@ import numpy as np
 import yaml
 
 from laserpick.bench.picking import Attempt, run_scene
-from laserpick.robot.objects import LIBRARY, rest_pose, support
+from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
 from laserpick.robot.scenes import SCENE_DIR, parse_scene
 from laserpick.robot.sim_robot import SimRobot
 
@@ -46,9 +46,7 @@ def _reach(name: str, yaw: float, d: np.ndarray) -> float:
     """How far (m) the object's footprint rectangle (as the scene checks overlaps) reaches
     along world direction d (unit, 2D) from its centre, at `yaw` (rad)."""
     model = LIBRARY[name]
-    rp = rest_pose(model)
-    ex = [support(model, e, rp.quat) for e in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0))]
-    half = np.array([(ex[0] + ex[1]) / 2, (ex[2] + ex[3]) / 2])
+    half = footprint_half_extents(model, rest_pose(model))
     c, s = math.cos(yaw), math.sin(yaw)
     return float(half[0] * abs(c * d[0] + s * d[1]) + half[1] * abs(-s * d[0] + c * d[1]))
 

@@ -312,6 +312,13 @@ _LYING_CANDIDATES = (
 )
 
 
+def footprint_half_extents(model: ObjectModel, rest: RestPose) -> np.ndarray:
+    """Half extents (m) of the object's footprint rectangle at rest, along its own (unyawed)
+    x and y axes: what a scene checks overlaps with."""
+    ex = [support(model, d, rest.quat) for d in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0))]
+    return np.array([(ex[0] + ex[1]) / 2, (ex[2] + ex[3]) / 2])
+
+
 def rest_pose(model: ObjectModel, lying: bool = False) -> RestPose:
     """The object's resting pose upright, or lying on its side.
 

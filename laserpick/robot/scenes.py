@@ -73,6 +73,7 @@ from laserpick.robot.objects import (
     OpticalKind,
     Part,
     add_object_body,
+    footprint_half_extents,
     opaque_names,
     quat_mul,
     rest_pose,
@@ -627,8 +628,7 @@ class _Builder:
             [xy[0] - offset[0], xy[1] - offset[1], surf.levels[level] + rp.z + REST_CLEARANCE]
         )
         # Footprint rectangle: extents along the object's yawed x and y axes.
-        ex = [support(model, d, rp.quat) for d in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0))]
-        half = np.array([(ex[0] + ex[1]) / 2, (ex[2] + ex[3]) / 2])
+        half = footprint_half_extents(model, rp)
         placement = Placement("", model, pos, q, surf.name, level, lying)
         return _Placed(
             placement, np.asarray(xy, dtype=float), rp.radius, (np.asarray(xy, float), half, yaw)
