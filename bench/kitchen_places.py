@@ -15,9 +15,17 @@ import argparse
 import math
 
 import numpy as np
+import yaml
 
 from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee, aim_with_tremor, creep, drive_to, parking_pose
+from laserpick.bench.operator import (
+    Referee,
+    aim_with_tremor,
+    creep,
+    drive_to,
+    parking_pose,
+    scene_config_backed,
+)
 from laserpick.bench.picking import mark_and_pick, stow
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -25,7 +33,7 @@ from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.types import Failure
-from laserpick.robot.scenes import SCENE_DIR, Surface, parse_scene
+from laserpick.robot.scenes import Surface, parse_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 
@@ -60,8 +68,7 @@ def run_task(seed: int, sources: tuple[str, ...] = SOURCES) -> tuple[bool, str]:
     rng = np.random.default_rng(seed)
     # The user starts half a metre back from the 73 cm table, raises the arm and drives up:
     # a stowed arm cannot rise past a table edge that high and that near (see the README).
-    text = (SCENE_DIR / "kitchen.yaml").read_text()
-    scene = parse_scene(text.replace("scooter: {x: 0.0,", f"scooter: {{x: {-START_BACK},"))
+    scene = parse_scene(yaml.safe_dump(scene_config_backed("kitchen", START_BACK)))
     robot = SimRobot(scene, realtime=False)
     try:
         robot.sim.settle(0.5)

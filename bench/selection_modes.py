@@ -13,20 +13,15 @@ import argparse
 import math
 
 import numpy as np
-import yaml
 
 from laserpick.bench.picking import Attempt, run_scene
 from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
-from laserpick.robot.scenes import SCENE_DIR, parse_scene
+from laserpick.robot.scenes import parse_scene, scene_config
 from laserpick.robot.sim_robot import SimRobot
 
 #: 004's set, as the `isolation` scene draws it, less the tall cereal box (it would hide its
 #: neighbour from every camera).
-MODELS = [
-    m
-    for m in yaml.safe_load((SCENE_DIR / "isolation.yaml").read_text())["random"][0]["models"]
-    if m != "cereal_box"
-]
+MODELS = [m for m in scene_config("isolation")["random"][0]["models"] if m != "cereal_box"]
 GAP = (0.0, 0.01)  #: m between the two objects, drawn uniformly: touching to 1 cm apart
 FIRST_XY = np.array([1.50, -0.36])  #: m, world: the first object, in front of the arm
 

@@ -18,14 +18,15 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+import yaml
 
 from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee, drive_to
+from laserpick.bench.operator import Referee, drive_to, scene_config_backed
 from laserpick.bench.picking import mark_target, pick_and_drop, stow
 from laserpick.description import dims
 from laserpick.pipeline.grasping import find_grasps
 from laserpick.pipeline.types import Failure
-from laserpick.robot.scenes import SCENE_DIR, load_scene, parse_scene
+from laserpick.robot.scenes import load_scene, parse_scene
 from laserpick.robot.sim_robot import SimRobot
 
 
@@ -63,9 +64,9 @@ def elee(log=print) -> list[bool]:
 
 def jeeves_scene(location: str, back: float) -> str:
     """The `jeeves` scene with the can on `location` and the scooter `back` m farther away."""
-    text = (SCENE_DIR / "jeeves.yaml").read_text()
-    text = text.replace("at: loc1}", f"at: {location}}}")
-    return text.replace("scooter: {x: 0.0,", f"scooter: {{x: {-back},")
+    config = scene_config_backed("jeeves", back)
+    config["objects"][0]["at"] = location
+    return yaml.safe_dump(config, sort_keys=False)
 
 
 def jeeves(trials: int, back: float = 0.4, log=print) -> list[bool]:

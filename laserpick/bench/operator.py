@@ -18,7 +18,7 @@ from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.types import DepthFrame, Grasp
-from laserpick.robot.scenes import Surface
+from laserpick.robot.scenes import Surface, scene_config
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import invert, planar_pose
 
@@ -44,7 +44,7 @@ class Referee:
         return [p.instance for p in self.robot.sim.scene.placements]  # type: ignore[union-attr]
 
     def world_position(self, instance: str) -> np.ndarray:
-        """The object's centre of mass in `world` (m)."""
+        """The object's origin in `world` (m): the centre of its bottom face when upright."""
         return self.robot.sim.snapshot().xpos[self.robot.sim.info.object_bodies[instance]].copy()
 
     def world_quat(self, instance: str) -> np.ndarray:
@@ -64,19 +64,23 @@ class Referee:
         self.robot.sim.call(move)
 
     def position(self, instance: str) -> np.ndarray:
-        """The object's centre of mass in `base` (m)."""
-        b = self.robot.sim.info.object_bodies[instance]
-        p = self.robot.sim.snapshot().xpos[b]
-        return (self._T_base_world() @ np.append(p, 1.0))[:3]
+        """The object's origin in `base` (m)."""
+        return (self._T_base_world() @ np.append(self.world_position(instance), 1.0))[:3]
 
-    def object_points(self, instance: str) -> np.ndarray:
-        """Points filling the object's bounds (m, `base`): its meshes' vertices, and a 7 x 7 x
-        7 grid over each primitive geom's box. Enough to say which object a grasp closes on."""
-        m = self.robot.model
-        b = self.robot.sim.info.object_bodies[instance]
-        d = mujoco.MjData(m)
+    def _posed(self) -> mujoco.MjData:
+        """A copy of the simulation's state with its kinematics computed, to read geoms from."""
+        d = mujoco.MjData(self.robot.model)
         d.qpos[:] = self.robot.sim.snapshot().qpos
-        mujoco.mj_kinematics(m, d)
+        mujoco.mj_kinematics(self.robot.model, d)
+        return d
+
+    def object_points(self, instance: str, posed: mujoco.MjData | None = None) -> np.ndarray:
+        """Points filling the object's bounds (m, `base`): its meshes' vertices, and a 7 x 7 x
+        7 grid over each primitive geom's box. Enough to say which object a grasp closes on.
+        posed: the state to read (default: now)."""
+        m = self.robot.model
+        d = posed if posed is not None else self._posed()
+        b = self.robot.sim.info.object_bodies[instance]
         pts = []
         for g in np.flatnonzero(m.geom_bodyid == b):
             if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
@@ -93,16 +97,18 @@ class Referee:
 
     def all_object_points(self) -> dict[str, np.ndarray]:
         """`object_points` of every object, now: take it before a pick moves them."""
-        return {name: self.object_points(name) for name in self.instances()}
+        posed = self._posed()
+        return {name: self.object_points(name, posed) for name in self.instances()}
 
     def grasped_object(
         self, grasp: Grasp, instances: list[str], points: dict[str, np.ndarray] | None = None
     ) -> str | None:
         """The object nearest the grasp's TCP (within 4 cm), or None. points: the objects'
         points as they stood before the grasp (default: as they stand now)."""
+        points = points if points is not None else self.all_object_points()
         best, best_d = None, 0.04
         for name in instances:
-            pts = points[name] if points is not None else self.object_points(name)
+            pts = points[name]
             d = float(np.min(np.linalg.norm(pts - grasp.position, axis=1)))
             if d < best_d:
                 best, best_d = name, d
@@ -139,6 +145,17 @@ def mark_and_capture(
     frames = robot.capture()
     robot.laser.off()
     return frames
+
+
+def scene_config_backed(name: str, back: float) -> dict:
+    """A built-in scene's configuration with the scooter starting `back` m farther back
+    along its heading; edit it further, then `parse_scene(yaml.safe_dump(config))`."""
+    config = scene_config(name)
+    start = config["scooter"]
+    yaw = math.radians(start.get("yaw_deg", 0.0))
+    start["x"] = start.get("x", 0.0) - back * math.cos(yaw)
+    start["y"] = start.get("y", 0.0) - back * math.sin(yaw)
+    return config
 
 
 def parking_pose(surface: Surface, local_y: float = 0.0) -> np.ndarray:

@@ -985,6 +985,14 @@ def builtin_scene_names() -> list[str]:
     return sorted(p.stem for p in SCENE_DIR.glob("*.yaml"))
 
 
+def scene_config(name: str) -> dict[str, Any]:
+    """A built-in scene's file as plain data (YAML 1.2 booleans, as `parse_scene` reads it),
+    to edit and pass back through `parse_scene(yaml.safe_dump(config))`."""
+    data = yaml.load((SCENE_DIR / f"{name}.yaml").read_text(), Loader=_SceneLoader)
+    assert isinstance(data, dict)
+    return data
+
+
 def parse_scene(
     text: str,
     source: Path | None = None,
