@@ -265,7 +265,9 @@ class Behaviours:
     def _release_and_retreat(self, plan: PickPlan) -> None:
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)
-        back = cartesian_line(self._q(), tcp_pose(plan.approach.q[0]), 0.01)
+        back = cartesian_line(
+            self._q(), tcp_pose(plan.approach.q[0]), self.settings.motion.cartesian_step
+        )
         if back is not None:
             self._run(timed(back, self.settings.motion, tcp_speed=0.1), "retreating")
 

@@ -209,40 +209,38 @@ class CollisionChecker:
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
         return clear & ~self._hits(centres, radius, margin).any(axis=1)
 
-    def _hits(self, centres: np.ndarray, radius: np.ndarray, margin: float) -> np.ndarray:
-        """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
+    def _contacts(
+        self, centres: np.ndarray, radius: np.ndarray, margin: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """For spheres (B, S) of `radius` (S,): whether each is below the floor's clearance
+        (B, S), within `margin` of each keep-out box (B, S, K), and of the cloud (B, S)."""
         B, S, _ = centres.shape
         reach = radius[None, :] + margin
-        hit = centres[..., 2] < radius + FLOOR_CLEARANCE
-        # Distance from each centre to each box (B, S, K).
+        floor = centres[..., 2] < radius + FLOOR_CLEARANCE
         gap = np.maximum(_LO - centres[..., None, :], centres[..., None, :] - _HI)
-        d_box = np.linalg.norm(np.maximum(gap, 0.0), axis=-1)
-        hit |= (d_box < reach[..., None]).any(axis=-1)
+        boxes = np.linalg.norm(np.maximum(gap, 0.0), axis=-1) < reach[..., None]
+        cloud = np.zeros((B, S), bool)
         if self.tree is not None:
-            flat = centres.reshape(-1, 3)
             bound = float(radius.max() + margin)
-            d, _ = self.tree.query(flat, k=1, distance_upper_bound=bound)
-            hit |= d.reshape(B, S) < reach
-        return hit
+            d, _ = self.tree.query(centres.reshape(-1, 3), k=1, distance_upper_bound=bound)
+            cloud = d.reshape(B, S) < reach
+        return floor, boxes, cloud
+
+    def _hits(self, centres: np.ndarray, radius: np.ndarray, margin: float) -> np.ndarray:
+        """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
+        floor, boxes, cloud = self._contacts(centres, radius, margin)
+        return floor | boxes.any(axis=-1) | cloud
 
     def what_hits(self, q: np.ndarray, *, hand: bool = True) -> list[str]:
-        """Names of what configuration q (6,) touches: "cloud", "floor", or a keep-out box."""
-        centres = sphere_centres(body_frames(q))[0]
+        """Names of what configuration q (6,) touches: "floor", a keep-out box, or "cloud"."""
+        centres = sphere_centres(body_frames(q))
         radius = SPHERES.radius
         if not hand:
-            centres, radius = centres[~SPHERES.hand], radius[~SPHERES.hand]
-        reach = radius + self.margin
-        names = []
-        if np.any(centres[:, 2] < radius + FLOOR_CLEARANCE):
-            names.append("floor")
-        gap = np.maximum(_LO - centres[:, None, :], centres[:, None, :] - _HI)
-        d_box = np.linalg.norm(np.maximum(gap, 0.0), axis=-1)
-        names += [b.name for k, b in enumerate(KEEPOUT_BOXES) if np.any(d_box[:, k] < reach)]
-        if self.tree is not None:
-            d, _ = self.tree.query(centres, k=1, distance_upper_bound=float(reach.max()))
-            if np.any(d < reach):
-                names.append("cloud")
-        return names
+            centres, radius = centres[:, ~SPHERES.hand], radius[~SPHERES.hand]
+        floor, boxes, cloud = self._contacts(centres, radius, self.margin)
+        names = ["floor"] if floor.any() else []
+        names += [b.name for k, b in enumerate(KEEPOUT_BOXES) if boxes[..., k].any()]
+        return names + (["cloud"] if cloud.any() else [])
 
     def segment_ok(
         self, qa: np.ndarray, qb: np.ndarray, *, step: float = 0.03, **kw: object
