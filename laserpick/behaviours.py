@@ -29,6 +29,7 @@ from laserpick.pipeline.collision import CollisionChecker, thin
 from laserpick.pipeline.grasping import GraspSet, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
+from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.surface import place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
@@ -256,8 +257,7 @@ class Behaviours:
         """After a stopped approach: straight back along the approach axis."""
         q = self._q()
         T = tcp_pose(q)
-        T_back = T.copy()
-        T_back[:3, 3] -= self.settings.motion.backoff * T[:3, 2]
+        T_back = pregrasp_pose(T, self.settings.motion.backoff)
         path = cartesian_line(q, T_back, self.settings.motion.cartesian_step)
         if path is not None:
             self._run(timed(path, self.settings.motion, tcp_speed=0.05), "backing off")

@@ -22,6 +22,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure
@@ -223,9 +224,7 @@ def plan_pick(
     ):
         return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
-    T_pre = T_grasp.copy()
-    T_pre[:3, 3] -= s.approach_distance * T_grasp[:3, 2]
-    pre = ik_tcp(T_pre, q_grasp)
+    pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
     if len(pre) == 0:
         return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
     q_pre = pre[0]
