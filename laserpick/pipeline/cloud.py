@@ -134,7 +134,7 @@ def fuse(frames: Sequence[DepthFrame], settings: PerceptionSettings | None = Non
     return cloud
 
 
-#: Largest voxel table `voxel_first` allocates (int64 entries); bigger boxes sort instead.
+#: Largest voxel table `voxel_first` allocates (int32 entries); bigger boxes sort instead.
 DENSE_VOXELS_MAX = 16_000_000
 
 
@@ -156,9 +156,10 @@ def voxel_first(points: np.ndarray, size: float) -> np.ndarray:
     packed = (keys[:, 0] * span[1] + keys[:, 1]) * span[2] + keys[:, 2]
     cells = int(np.prod(span))
     if cells <= DENSE_VOXELS_MAX:
-        table = np.full(cells, n, np.int64)
-        np.minimum.at(table, packed, np.arange(n, dtype=np.int64))
-        return np.sort(table[table < n])
+        index = np.int32 if n < np.iinfo(np.int32).max else np.int64  # int32 fills faster
+        table = np.full(cells, n, index)
+        np.minimum.at(table, packed, np.arange(n, dtype=index))
+        return np.sort(table[table < n]).astype(np.int64)
     if np.any(span >= 1 << 21):  # the packed key could overflow: sort rows
         _, first = np.unique(keys, axis=0, return_index=True)
     else:
