@@ -135,7 +135,8 @@ class CollisionChecker:
     obstacles: (N, 3) points in `base` (m). Points beyond the arm's reach are dropped, the
     rest thinned to one per `voxel` (m) for the KD-tree. margin: clearance (m) kept from
     every obstacle on top of the spheres' radii. q_self: the arm's joint angles when the
-    points were captured, to filter out the arm's own points.
+    points were captured, to filter out the arm's own points. filtered: the points have
+    been through `obstacle_mask` already (voxel and q_self are then unused).
     """
 
     def __init__(
@@ -145,9 +146,12 @@ class CollisionChecker:
         margin: float = 0.01,
         voxel: float = 0.01,
         q_self: np.ndarray | None = None,
+        filtered: bool = False,
     ):
         pts = np.asarray(obstacles, float).reshape(-1, 3)
-        self.points = pts[obstacle_mask(pts, voxel=voxel, q_self=q_self)]
+        if not filtered:  # `filtered`: the points already passed obstacle_mask
+            pts = pts[obstacle_mask(pts, voxel=voxel, q_self=q_self)]
+        self.points = pts
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.margin = margin
 
@@ -168,8 +172,8 @@ class CollisionChecker:
         others = keep.copy()
         others[target] = False
         return (
-            cls(pts[keep], margin=margin, voxel=0.0),
-            cls(pts[others], margin=margin, voxel=0.0),
+            cls(pts[keep], margin=margin, filtered=True),
+            cls(pts[others], margin=margin, filtered=True),
         )
 
     def clearance_ok(
