@@ -111,6 +111,8 @@ class Behaviours:
     """The robot's behaviours, run one at a time from the caller's thread.
 
     progress: called with a short sentence at each step, for the console and logs.
+    should_stop: polled before every motion; once it returns True (the operator cancelled,
+    or the watchdog fired) no new motion starts and the behaviour ends with a failure.
     """
 
     def __init__(
@@ -119,8 +121,10 @@ class Behaviours:
         settings: Settings | None = None,
         rng: np.random.Generator | None = None,
         progress: Callable[[str], None] | None = None,
+        should_stop: Callable[[], bool] | None = None,
     ) -> None:
         self.robot = robot
+        self.should_stop = should_stop or (lambda: False)
         self.settings = settings or get_settings()
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.progress = progress or (lambda msg: log.info(msg))
@@ -129,6 +133,8 @@ class Behaviours:
     # --- motion primitives -------------------------------------------------------------------
 
     def _run(self, traj: Trajectory, what: str) -> Failure | None:
+        if self.should_stop():
+            return Failure("execute", f"Stopped before {what}: the motion was cancelled.")
         handle = self.robot.execute(traj)
         status = self.robot.wait(handle, traj.duration + MOTION_SLACK)
         if status == "done":
@@ -178,7 +184,9 @@ class Behaviours:
             if T[2, 3] < ready_z - 0.01 and T[0, 3] > WORKSPACE_X:
                 T[2, 3] = ready_z
                 up = cartesian_line(self._q(), T, self.settings.motion.cartesian_step)
-                if up is not None:
+                # Only when the whole rise is clear: rising into the scooter's camera heads
+                # would leave the planner no collision-free start.
+                if up is not None and checker.clearance_ok(up).all():
                     failure = self._run(timed(up, self.settings.motion), "rising")
                     if failure is not None:
                         return Outcome(failure)
@@ -425,6 +433,9 @@ class Behaviours:
             return Failure("precondition", "There is no target to drive to.")
         pose = self.robot.base_pose()
         for _ in range(APPROACH_MAX_STEPS):
+            if self.should_stop():
+                self.robot.drive(0.0, 0.0, 0.1)
+                return Failure("execute", "The drive to the object was cancelled.")
             points = perception.target_points.astype(float)
             centroid = points.mean(axis=0)
             top = points[points[:, 2] > points[:, 2].max() - 0.01].mean(axis=0)

@@ -1,16 +1,18 @@
 """The `laserpick` console script.
 
     laserpick serve [--host 127.0.0.1] [--port 8000] [--viser-port 8080] [--scene isolation]
+                    [--journal FILE]
 
-`serve` loads a scene (a built-in name or a YAML path), runs the real-time simulation, and
-serves the viser 3D console. It prints `laserpick: console at http://HOST:PORT` once the
-console is up, and shuts down cleanly on Ctrl-C or SIGTERM.
+`serve` loads a scene (a built-in name or a YAML path), runs the real-time simulation and the
+operator session, serves the page and the API (uvicorn) and the viser 3D view, and records
+the session in the journal. It prints `laserpick: console at http://HOST:PORT/` once the API
+is up, and shuts down cleanly on Ctrl-C or SIGTERM.
 
 Security: it binds the loopback interface by default. Binding anything else is refused unless
-`LASERPICK_OPERATOR_PASSWORD` is set, because whoever reaches the ports can watch (and, once
-the HTTP API lands, command) a robot. The viser port has no authentication of its own, so on a
-non-loopback host the console is view-only (no Pause button) and should sit behind the TLS
-proxy in deploy/.
+`LASERPICK_OPERATOR_PASSWORD` is set, because whoever reaches the ports can watch or command
+a robot; taking control then needs that password. The viser port has no authentication of its
+own, so on a non-loopback host the 3D view is view-only (no Pause button) and should sit
+behind the TLS proxy in deploy/.
 
 Exit codes: 0 clean shutdown, 2 bad usage (unknown scene, refused host).
 """
@@ -18,15 +20,15 @@ Exit codes: 0 clean shutdown, 2 bad usage (unknown scene, refused host).
 from __future__ import annotations
 
 import argparse
+import asyncio
 import ipaddress
 import logging
 import os
-import signal
 import socket
 import sys
-import threading
+import uuid
 from collections.abc import Sequence
-from types import FrameType
+from pathlib import Path
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
@@ -75,9 +77,15 @@ def build_parser() -> argparse.ArgumentParser:
         "--port",
         type=int,
         default=8000,
-        help="HTTP API port (reserved: the API is not served yet)",
+        help="HTTP port of the page and the API (default 8000; 0 picks a free one)",
     )
-    serve.add_argument("--viser-port", type=int, default=8080, help="3D console port")
+    serve.add_argument("--viser-port", type=int, default=8080, help="3D view (viser) port")
+    serve.add_argument(
+        "--journal",
+        type=Path,
+        default=None,
+        help="SQLite journal of the session (default $XDG_DATA_HOME/laserpick/journal.sqlite3)",
+    )
     serve.add_argument(
         "--scene",
         default="isolation",
@@ -94,8 +102,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def default_journal() -> Path:
+    """Where the journal lives by default: $XDG_DATA_HOME/laserpick/journal.sqlite3."""
+    root = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(root) / "laserpick" / "journal.sqlite3"
+
+
 def cmd_serve(args: argparse.Namespace) -> int:
-    """Run the simulation and the 3D console until SIGINT or SIGTERM."""
+    """Run the simulation, the API and the 3D console until SIGINT or SIGTERM."""
     loopback = is_loopback(args.host)
     if not loopback and not os.environ.get(PASSWORD_ENV):
         _say(
@@ -120,51 +134,77 @@ def cmd_serve(args: argparse.Namespace) -> int:
         _say(f"cannot load scene {args.scene!r}: {exc}", err=True)
         return EXIT_USAGE
 
+    from laserpick.server.journal import Journal, JournalError
+
+    try:
+        journal = Journal(args.journal or default_journal(), session=uuid.uuid4().hex)
+    except (JournalError, OSError) as exc:
+        _say(f"cannot open the journal: {exc}", err=True)
+        return EXIT_USAGE
+
+    import uvicorn
     import viser
 
     from laserpick.console.viewer import SceneViewer
-    from laserpick.robot.sim import Simulation
+    from laserpick.robot.sim_robot import SimRobot
+    from laserpick.server.app import create_app
+    from laserpick.server.session import Session
 
-    stop = threading.Event()
-
-    def on_signal(signum: int, _frame: FrameType | None) -> None:
-        stop.set()
-
-    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
-    sim = Simulation(scene, realtime=True)
+    session = Session(SimRobot(scene, realtime=True), journal=journal)
     server: viser.ViserServer | None = None
     viewer: SceneViewer | None = None
     try:
-        sim.start()
         server = viser.ViserServer(
             host=args.host, port=args.viser_port, label="laserpick", verbose=False
         )
         viewer = SceneViewer(
-            sim, server, rate_hz=args.viewer_rate, controls=loopback, shadows=args.shadows
+            session.robot.sim,
+            server,
+            rate_hz=args.viewer_rate,
+            controls=loopback,
+            shadows=args.shadows,
         )
         viewer.start()
-        port = server.get_port()
-        if port != args.viser_port and args.viser_port != 0:
-            _say(f"port {args.viser_port} was busy; the console took {port}", err=True)
+        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))
+        viser_port = server.get_port()
+        if viser_port != args.viser_port and args.viser_port != 0:
+            _say(f"port {args.viser_port} was busy; the 3D view took {viser_port}", err=True)
         if not loopback:
             _say(
-                "the 3D console port has no authentication of its own: it is view-only here; "
+                "the 3D view's port has no authentication of its own: it is view-only here; "
                 "put it behind the TLS proxy (deploy/)",
                 err=True,
             )
-        _say(f"console at http://{_url_host(args.host)}:{port}")
-        while not stop.wait(0.2):
-            pass
+        app = create_app(session, viser_port=viser_port)
+        config = uvicorn.Config(
+            app,
+            host=args.host,
+            port=args.port,
+            log_level="warning",
+            ws="websockets-sansio",
+        )
+        api = uvicorn.Server(config)
+
+        async def serve() -> None:
+            task = asyncio.create_task(api.serve())
+            while not api.started and not task.done():
+                await asyncio.sleep(0.05)
+            if api.started:
+                port = api.servers[0].sockets[0].getsockname()[1]
+                _say(f"console at http://{_url_host(args.host)}:{port}/")
+                _say(f"3D view at http://{_url_host(args.host)}:{viser_port}/")
+            await task
+
+        asyncio.run(serve())  # uvicorn handles SIGINT and SIGTERM: a graceful shutdown
         _say("shutting down")
+        return 0 if api.started else 1
     finally:
         if viewer is not None:
             viewer.stop()
-        sim.close()
+        session.close()
         if server is not None:
             server.stop()
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-    return 0
+        journal.close()
 
 
 def main(argv: Sequence[str] | None = None) -> int:

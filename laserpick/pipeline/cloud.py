@@ -170,3 +170,24 @@ def voxel_first(points: np.ndarray, size: float) -> np.ndarray:
 def voxel_downsample(cloud: FusedCloud, size: float) -> FusedCloud:
     """Keep the first point (in cloud order) of each occupied voxel of edge `size` (m)."""
     return cloud.subset(voxel_first(cloud.points, size))
+
+
+def ray_hit(
+    points: np.ndarray, origin: np.ndarray, direction: np.ndarray, radius: float = 0.01
+) -> np.ndarray | None:
+    """Where a ray first meets a cloud: of the points (N, 3) m within `radius` (m) of the ray
+    from `origin` (3,) along `direction` (3,), the one nearest the origin along the ray, as
+    a (3,) float64 point; None if the ray passes every point. A click in the 3D view gives a
+    ray; this turns it into the point the user meant. All in one frame (e.g. `base`)."""
+    d = np.asarray(direction, dtype=np.float64)
+    norm = float(np.linalg.norm(d))
+    if not np.isfinite(norm) or norm == 0.0:
+        raise ValueError("the ray's direction must be a finite, non-zero vector")
+    d /= norm
+    rel = np.asarray(points, dtype=np.float64) - np.asarray(origin, dtype=np.float64)
+    along = rel @ d
+    off2 = np.einsum("ij,ij->i", rel, rel) - along**2
+    near = np.flatnonzero((along > 0.0) & (off2 <= radius * radius))
+    if len(near) == 0:
+        return None
+    return rel[near[np.argmin(along[near])]] + np.asarray(origin, dtype=np.float64)

@@ -14,14 +14,18 @@ from concurrent.futures import ThreadPoolExecutor
 import mujoco
 import numpy as np
 
+from laserpick.description import dims
+from laserpick.pipeline.projector import Projector
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import DepthFrame
 from laserpick.robot.interface import GripperState, JointState
 from laserpick.robot.laser import LaserPointer
+from laserpick.robot.model import camera_rotation
 from laserpick.robot.scenes import Scene
-from laserpick.robot.sensors import DepthCameras
+from laserpick.robot.sensors import CAM_TO_OPTICAL, DepthCameras
 from laserpick.robot.sim import MotionHandle, Simulation, Snapshot
 from laserpick.settings import Settings, get_settings
+from laserpick.transforms import make_transform, pinhole_intrinsics
 
 
 class SimRobot:
@@ -64,6 +68,13 @@ class SimRobot:
         """World points where the lit beams land now (simulator truth; for display and scoring)."""
         snap = snap or self.sim.snapshot()
         return self._capture_pool.submit(self._cast, snap).result()
+
+    def projector(self) -> Projector:
+        """The scooter's projector as a virtual camera in `base` (its calibration)."""
+        R = camera_rotation(dims.PROJECTOR_PITCH_DOWN, dims.PROJECTOR_YAW) @ CAM_TO_OPTICAL
+        K = pinhole_intrinsics(dims.PROJECTOR_WIDTH, dims.PROJECTOR_HEIGHT, dims.PROJECTOR_FOVY)
+        T = make_transform(R, np.asarray(dims.PROJECTOR_POS, dtype=float))
+        return Projector(K, T, dims.PROJECTOR_WIDTH, dims.PROJECTOR_HEIGHT)
 
     def joint_state(self) -> JointState:
         s = self.sim.snapshot()

@@ -1,0 +1,1 @@
+"""The laserpick server: the operator-session web API and its journal."""

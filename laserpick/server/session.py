@@ -1,0 +1,868 @@
+"""The operator session: the one task state machine behind every input.
+
+Console buttons, REST calls, the switch and joystick adapters and the benchmarks all call the
+methods of one `Session`; nothing else changes task state (rule 2 of the design). The task:
+
+    idle ─aim→ aiming ─confirm→ marked → perceived → grasps_ready ─execute→ executing
+      ↑                                                                      │
+      └──────────── (dropped in the basket, or placed, then stowed) ←── holding
+                                                     awaiting_place ─confirm→ placing
+
+- idle: nothing under way; the laser may be off.
+- aiming: the aiming beam is lit; aim and nudge move it.
+- marked: both beams lit; the frames are being captured and the mark found.
+- perceived: the target is segmented and lit by the projector; grasps are being found (or
+  were not: `detect` tries again, perhaps with another strategy).
+- grasps_ready: clusters and a current candidate; next, prev, select and auto move it.
+- executing: the arm picks (for the Jeeves strategy the base drove to the object first).
+- holding: the object is in the hand (carried to the basket in pick-and-drop; after a
+  cancel, waiting for `execute` to drop it or for a place mark).
+- awaiting_place: pick-and-place holds the object high and waits for the place mark.
+- placing: the arm sets the object down at the mark, then stows.
+
+Long work (perception, grasp detection, every arm motion) runs on one worker thread, so no
+caller waits on it and the API stays responsive. A failure returns to a safe resting state
+with a typed `Failure`; cancel aborts the job, halts the arm and retreats; the e-stop halts
+at once and latches. The watchdog halts motion commanded by a lease holder who goes silent.
+
+Frames: points in `base` (m) unless a method says `world`; angles in radians.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import threading
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Any, Literal
+
+import numpy as np
+
+from laserpick.behaviours import GRIPPER_TIME, Behaviours
+from laserpick.description import dims
+from laserpick.pipeline.cloud import fuse, ray_hit, voxel_downsample
+from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.laser import detect_mark
+from laserpick.pipeline.perceive import Perception, perceive
+from laserpick.pipeline.projector import highlight_disc, highlight_points
+from laserpick.pipeline.selection import GraspCursor
+from laserpick.pipeline.types import Failure, FusedCloud, Grasp
+from laserpick.robot.scenes import Scene
+from laserpick.robot.sim_robot import SimRobot
+from laserpick.server.journal import Journal
+from laserpick.server.lease import ControlLease
+from laserpick.settings import Settings, get_settings
+from laserpick.transforms import invert, planar_pose
+
+log = logging.getLogger(__name__)
+
+Mode = Literal["pick_and_drop", "pick_and_place"]
+Selection = Literal["auto", "manual"]
+#: gpd: 004's 6-DOF candidates; overhead: EL-E's (000 section 4.4); jeeves: drive the base to
+#: the target's centroid, then grasp from above (003 section IV).
+StrategyName = Literal["gpd", "overhead", "jeeves"]
+Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
+
+
+class TaskState(StrEnum):
+    IDLE = "idle"
+    AIMING = "aiming"
+    MARKED = "marked"
+    PERCEIVED = "perceived"
+    GRASPS_READY = "grasps_ready"
+    EXECUTING = "executing"
+    HOLDING = "holding"
+    AWAITING_PLACE = "awaiting_place"
+    PLACING = "placing"
+
+
+#: States where the laser may be aimed (and the mark, or the place mark, confirmed).
+AIMABLE = frozenset(
+    {
+        TaskState.IDLE,
+        TaskState.AIMING,
+        TaskState.PERCEIVED,
+        TaskState.GRASPS_READY,
+        TaskState.HOLDING,
+        TaskState.AWAITING_PLACE,
+    }
+)
+#: States that hold an object: aiming there chooses where to place it.
+HOLDING_STATES = frozenset({TaskState.HOLDING, TaskState.AWAITING_PLACE})
+
+
+class Conflict(Exception):
+    """A command that the current state does not allow (HTTP 409). `state` is the state."""
+
+    def __init__(self, message: str, state: TaskState) -> None:
+        super().__init__(message)
+        self.state = state
+
+
+@dataclass(frozen=True)
+class Actor:
+    """Who asks: the input source, and the lease token when it came through the API (None
+    for in-process callers such as the 3D console, which the watchdog does not watch)."""
+
+    source: Source
+    token: str | None = None
+
+
+SYSTEM = Actor("system")
+
+
+@dataclass
+class _Task:
+    """What the current task has found so far."""
+
+    perception: Perception | None = None
+    grasps: GraspSet | None = None
+    cursor: GraspCursor | None = None
+    place_mark: np.ndarray | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
+    return None if a is None else [round(float(x), digits) for x in np.ravel(a)]
+
+
+def grasp_summary(g: Grasp) -> dict[str, Any]:
+    """A grasp as JSON: pose (4x4, `base`), width (m), score and its five factors."""
+    scores = g.scores
+    return {
+        "pose": [_vec(row) for row in g.pose],
+        "position": _vec(g.position),
+        "approach": _vec(g.approach),
+        "width": round(float(g.width), 4),
+        "score": round(float(g.score), 4),
+        "factors": None
+        if scores is None
+        else {k: round(float(getattr(scores, k)), 4) for k in ("Cw", "Cj", "Ca", "Cs", "Cp")},
+        "cluster": g.cluster,
+    }
+
+
+class Session:
+    """The task state machine around one simulated robot.
+
+    robot: a real-time `SimRobot` (the session drives the laser, a simulated hand-held
+    pointer, as well as the robot). journal: where every command and outcome is recorded.
+    """
+
+    def __init__(
+        self,
+        robot: SimRobot,
+        *,
+        journal: Journal | None = None,
+        settings: Settings | None = None,
+    ) -> None:
+        self.settings = settings or get_settings()
+        self.journal = journal
+        self.lease = ControlLease(self.settings.server.lease_timeout_s)
+        self._lock = threading.RLock()
+        self._listeners: list[Callable[[dict[str, Any]], None]] = []
+        self._scene_listeners: list[Callable[[SimRobot], None]] = []
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="laserpick-session")
+        self._job: Future[None] | None = None
+        self._job_name = ""
+        self._cancel = threading.Event()
+        self._motion_token: str | None = None  #: whose heartbeat the running motion needs
+        self._drive_token: str | None = None
+        self._drive_until = 0.0
+        self.mode: Mode = "pick_and_drop"
+        self.selection: Selection = "auto"
+        self.strategy: StrategyName = "gpd"
+        self._rng = np.random.default_rng(self.settings.server.seed)
+        self._attach(robot)
+        self._closing = threading.Event()
+        self._watchdog = threading.Thread(
+            target=self._watch, name="laserpick-watchdog", daemon=True
+        )
+        self._watchdog.start()
+
+    def _attach(self, robot: SimRobot) -> None:
+        self.robot = robot
+        self.behaviours = Behaviours(
+            robot,
+            self.settings,
+            rng=self._rng,
+            progress=self._progress,
+            should_stop=self._cancel.is_set,
+        )
+        self.projector = robot.projector()
+        self.state = TaskState.IDLE
+        self.task = _Task()
+        self.failure: Failure | None = None
+        self.message = "Ready. Aim the laser at an object."
+        self._projection: np.ndarray | None = None
+        self._cloud: FusedCloud | None = None
+        self._cloud_pose: np.ndarray | None = None
+
+    def close(self) -> None:
+        """Halt, stop the worker and the watchdog, and close the robot."""
+        self._closing.set()
+        self._cancel.set()
+        self.robot.halt()
+        self._worker.shutdown(wait=True, cancel_futures=True)
+        self._watchdog.join(timeout=1.0)
+        self.robot.close()
+
+    # --- listeners --------------------------------------------------------------------------
+
+    def on_event(self, fn: Callable[[dict[str, Any]], None]) -> None:
+        """Call `fn(event)` for every discrete event (from any thread; keep it quick)."""
+        self._listeners.append(fn)
+
+    def on_scene(self, fn: Callable[[SimRobot], None]) -> None:
+        """Call `fn(robot)` after a scene reset replaced the robot (the 3D view rebuilds)."""
+        self._scene_listeners.append(fn)
+
+    def _emit(self, name: str, /, **fields: Any) -> None:
+        event = {"type": "event", "name": name, "t": time.time(), "state": self.state.value}
+        event.update(fields)
+        for fn in list(self._listeners):
+            try:
+                fn(event)
+            except Exception:  # a listener's bug must not stop the task
+                log.exception("event listener failed")
+
+    def _record(
+        self,
+        actor: Actor,
+        action: str,
+        outcome: str,
+        failure: Failure | None = None,
+        message: str = "",
+        timings: dict[str, float] | None = None,
+    ) -> None:
+        if self.journal is None:
+            return
+        try:
+            self.journal.record(
+                source=actor.source,
+                action=action,
+                outcome=outcome,
+                failure=failure.kind if failure else None,
+                message=failure.message if failure else message,
+                timings=timings,
+                detail={"state": self.state.value},
+            )
+        except Exception:  # the robot must not stop because the disk is full
+            log.exception("journal write failed")
+
+    def _progress(self, message: str) -> None:
+        self.message = message
+        self._emit("progress", message=message)
+
+    def _set(self, state: TaskState, message: str | None = None) -> None:
+        self.state = state
+        if message is not None:
+            self.message = message
+        self._emit("state", message=self.message)
+
+    def _fail(self, failure: Failure, state: TaskState) -> None:
+        self.failure = failure
+        self._set(state, failure.message)
+        self._emit("failure", kind=failure.kind, message=failure.message)
+
+    # --- guards -----------------------------------------------------------------------------
+
+    @property
+    def busy(self) -> bool:
+        return self._job is not None and not self._job.done()
+
+    @property
+    def estopped(self) -> bool:
+        return self.robot.sim.snapshot().estopped
+
+    def _refuse(self, actor: Actor, action: str, message: str) -> Conflict:
+        self._record(actor, action, "refused", message=message)
+        return Conflict(message, self.state)
+
+    def _require(
+        self, actor: Actor, action: str, states: Sequence[TaskState] | frozenset[TaskState]
+    ) -> None:
+        if self.busy:
+            raise self._refuse(actor, action, f"busy ({self._job_name}); cancel it first")
+        if self.state not in states:
+            allowed = ", ".join(sorted(s.value for s in states))
+            raise self._refuse(
+                actor, action, f"not allowed while {self.state.value} (allowed when: {allowed})"
+            )
+
+    def _require_motion(self, actor: Actor, action: str) -> None:
+        if self.estopped:
+            raise self._refuse(actor, action, "the e-stop is latched; reset it first")
+
+    def _start(self, actor: Actor, name: str, job: Callable[[], None], *, motion: bool) -> None:
+        self._cancel.clear()
+        self.failure = None
+        self._job_name = name
+        self._motion_token = actor.token if motion else None
+        self._job = self._worker.submit(self._run_job, actor, name, job)
+
+    def _run_job(self, actor: Actor, name: str, job: Callable[[], None]) -> None:
+        t0 = time.perf_counter()
+        try:
+            job()
+        except Exception as exc:  # a bug in a job must leave the robot at rest, not running
+            log.exception("session job %s failed", name)
+            self.robot.halt()
+            with self._lock:
+                failure = Failure("execute", f"Internal error while {name}: {exc}")
+                self._fail(failure, TaskState.IDLE)
+        finally:
+            with self._lock:
+                self._motion_token = None
+                self.task.timings[f"{name}_total"] = time.perf_counter() - t0
+                outcome = (
+                    "cancelled" if self._cancel.is_set() else "failed" if self.failure else "done"
+                )
+                self._record(actor, name, outcome, self.failure, self.message, self.task.timings)
+                self._emit("job", job=name, outcome=outcome, message=self.message)
+
+    # --- the laser --------------------------------------------------------------------------
+
+    def _after_aim(self) -> None:
+        """Aiming: a new target drops what was found for the old one."""
+        if self.state in HOLDING_STATES:
+            self._set(TaskState.AWAITING_PLACE, "Mark where to put it, then confirm.")
+        elif self.state != TaskState.AIMING:
+            self.task = _Task()
+            self._projection = None
+            self._set(TaskState.AIMING, "Aim at the object, then confirm.")
+
+    def aim(self, actor: Actor, yaw: float, pitch: float) -> None:
+        """Point the laser at (yaw, pitch) rad in `base` (clamped to the pointer's limits)."""
+        with self._lock:
+            self._require(actor, "laser/aim", AIMABLE)
+            self.robot.laser.aim(yaw, pitch)
+            self._after_aim()
+            self._record(actor, "laser/aim", "ok")
+
+    def aim_at(self, actor: Actor, point: np.ndarray, frame: Literal["base", "world"]) -> None:
+        """Point the laser at a point (m) in `base` or `world`."""
+        p = self._to_base(np.asarray(point, dtype=float), frame)
+        with self._lock:
+            self._require(actor, "laser/aim", AIMABLE)
+            self.robot.laser.aim_at(p)
+            self._after_aim()
+            self._record(actor, "laser/aim", "ok")
+
+    def aim_ray(
+        self,
+        actor: Actor,
+        origin: np.ndarray,
+        direction: np.ndarray,
+        frame: Literal["base", "world"],
+    ) -> np.ndarray:
+        """Point the laser where a ray (a click in the 3D view) first meets the fused cloud;
+        the hit point in `base` (m). ValueError when the ray misses everything."""
+        o = self._to_base(np.asarray(origin, dtype=float), frame)
+        d = self._to_base(np.asarray(direction, dtype=float), frame, direction=True)
+        cloud = self.cloud()
+        hit = ray_hit(cloud.points, o, d, radius=self.settings.server.cloud_voxel)
+        if hit is None:
+            raise ValueError("the ray meets no point of the cloud")
+        self.aim_at(actor, hit, "base")
+        return hit
+
+    def nudge(self, actor: Actor, dyaw: float, dpitch: float) -> None:
+        """Turn the laser by small steps (rad), as a joystick or switch does."""
+        with self._lock:
+            self._require(actor, "laser/nudge", AIMABLE)
+            self.robot.laser.nudge(dyaw, dpitch)
+            self._after_aim()
+            self._record(actor, "laser/nudge", "ok")
+
+    def laser_off(self, actor: Actor) -> None:
+        with self._lock:
+            self._require(actor, "laser/off", AIMABLE)
+            self.robot.laser.off()
+            if self.state == TaskState.AIMING:
+                self._set(TaskState.IDLE, "Laser off.")
+            self._record(actor, "laser/off", "ok")
+
+    def confirm(self, actor: Actor) -> None:
+        """Light both beams: mark the object (then perceive and find grasps), or, holding an
+        object in pick-and-place, mark where it goes (then place it)."""
+        with self._lock:
+            self._require(actor, "laser/confirm", (TaskState.AIMING, TaskState.AWAITING_PLACE))
+            if not self.robot.laser.state.on:
+                raise self._refuse(actor, "laser/confirm", "the laser is off; aim it first")
+            self.robot.laser.confirm()
+            self._record(actor, "laser/confirm", "ok")
+            if self.state == TaskState.AWAITING_PLACE:
+                self._require_motion(actor, "laser/confirm")
+                self._start(actor, "placing", self._place_job, motion=True)
+            else:
+                if self.strategy == "jeeves":
+                    self._require_motion(actor, "laser/confirm")
+                self._set(TaskState.MARKED, "Marked. Looking at the object.")
+                self._start(
+                    actor, "perceiving", self._perceive_job, motion=self.strategy == "jeeves"
+                )
+
+    def detect(self, actor: Actor) -> None:
+        """Find grasps again for the perceived target (e.g. after changing the strategy)."""
+        with self._lock:
+            self._require(actor, "detect", (TaskState.PERCEIVED, TaskState.GRASPS_READY))
+            if self.strategy == "jeeves":
+                self._require_motion(actor, "detect")
+            self._set(TaskState.PERCEIVED, "Finding grasps.")
+            self._start(actor, "detecting", self._grasp_job, motion=self.strategy == "jeeves")
+
+    # --- grasp choice -----------------------------------------------------------------------
+
+    def _cursor(self, actor: Actor, action: str) -> GraspCursor:
+        self._require(actor, action, (TaskState.GRASPS_READY,))
+        assert self.task.cursor is not None
+        return self.task.cursor
+
+    def step_grasp(self, actor: Actor, step: int, level: Literal["cluster", "candidate"]) -> None:
+        """Move the current grasp by one cluster, or one candidate within the cluster."""
+        action = "grasps/next" if step > 0 else "grasps/prev"
+        with self._lock:
+            cur = self._cursor(actor, action)
+            if level == "cluster":
+                cur.next() if step > 0 else cur.prev()
+            else:
+                cur.next_candidate() if step > 0 else cur.prev_candidate()
+            self._grasp_changed(actor, action)
+
+    def select_grasp(self, actor: Actor, cluster: int, candidate: int) -> None:
+        """Make a cluster's candidate (0-based) the current grasp; IndexError if out of range."""
+        with self._lock:
+            cur = self._cursor(actor, "grasps/select")
+            cur.select(cluster, candidate)
+            self._grasp_changed(actor, "grasps/select")
+
+    def auto_grasp(self, actor: Actor) -> None:
+        """Back to the system's choice: the best grasp of the best cluster."""
+        with self._lock:
+            cur = self._cursor(actor, "grasps/auto")
+            cur.select(0, 0)
+            self._grasp_changed(actor, "grasps/auto")
+
+    def _grasp_changed(self, actor: Actor, action: str) -> None:
+        assert self.task.cursor is not None
+        self.message = self.task.cursor.describe()
+        self._emit("grasp", message=self.message)
+        self._record(actor, action, "ok", message=self.message)
+
+    # --- execution --------------------------------------------------------------------------
+
+    def execute(self, actor: Actor) -> None:
+        """Pick with the current grasp (manual) or the best that plans (auto); in holding,
+        drop what the hand holds in the basket."""
+        with self._lock:
+            self._require(actor, "execute", (TaskState.GRASPS_READY, TaskState.HOLDING))
+            self._require_motion(actor, "execute")
+            if self.state == TaskState.HOLDING:
+                self._start(actor, "dropping", self._drop_job, motion=True)
+                return
+            grasps, cursor = self.task.grasps, self.task.cursor
+            assert grasps is not None and cursor is not None
+            if self.selection == "manual":
+                members = grasps.clusters.clusters[cursor.cluster]
+                chosen = members[cursor.candidate]
+                rest = [grasps.clusters.grasps[i] for i in members if i != chosen]
+                order = [cursor.current, *rest]
+            else:
+                order = grasps.ordered()
+            self._set(TaskState.EXECUTING, "Picking.")
+            self._start(actor, "picking", lambda: self._pick_job(order), motion=True)
+
+    def cancel(self, actor: Actor) -> None:
+        """Abort what is under way: halt the arm and base; a job then retreats to a safe pose.
+        Without a job, drop the found target (or the place mark) and rest."""
+        with self._lock:
+            if self.busy:
+                self._cancel.set()
+                self.robot.halt()
+                self._progress("Cancelling.")
+            elif self.state in (TaskState.AIMING, TaskState.PERCEIVED, TaskState.GRASPS_READY):
+                self.robot.laser.off()
+                self.task = _Task()
+                self._projection = None
+                self._set(TaskState.IDLE, "Cancelled.")
+            elif self.state == TaskState.AWAITING_PLACE:
+                self.robot.laser.off()
+                self._set(TaskState.HOLDING, "Holding. Execute drops it in the basket.")
+            self._record(actor, "cancel", "ok")
+
+    def drive(self, actor: Actor, v: float, w: float, duration: float) -> None:
+        """Drive the base at v (m/s) and w (rad/s) for at most `duration` s (<= 0.5 s: a
+        dead-man; send it again to keep going). What was perceived is stale afterwards."""
+        with self._lock:
+            self._require(actor, "drive", AIMABLE)
+            self._require_motion(actor, "drive")
+            self.robot.drive(v, w, duration)
+            self._drive_token = actor.token
+            self._drive_until = time.monotonic() + duration
+            if self.state in (TaskState.PERCEIVED, TaskState.GRASPS_READY):
+                self.task = _Task()
+                self._projection = None
+                aiming = self.robot.laser.state.on
+                self._set(TaskState.AIMING if aiming else TaskState.IDLE, "Driving.")
+            self._cloud = None
+
+    def stop(self, actor: Actor) -> None:
+        """E-stop: arm and base halt within one control tick and stay halted until reset."""
+        self.robot.stop()
+        self._cancel.set()
+        with self._lock:
+            self._drive_until = 0.0
+            self.message = "E-STOP. Motion is halted until the stop is reset."
+            self._emit("estop", message=self.message)
+            self._record(actor, "stop", "ok")
+
+    def reset_stop(self, actor: Actor) -> None:
+        with self._lock:
+            if self.busy:
+                raise self._refuse(actor, "stop/reset", "the stopped job is still winding down")
+            self.robot.reset_stop()
+            self.message = "Stop reset."
+            self._emit("estop_reset", message=self.message)
+            self._record(actor, "stop/reset", "ok")
+
+    def set_mode(
+        self,
+        actor: Actor,
+        mode: Mode | None = None,
+        selection: Selection | None = None,
+        strategy: StrategyName | None = None,
+    ) -> None:
+        """Change the task mode, the selection mode or the grasp strategy (None: keep)."""
+        with self._lock:
+            if self.busy:
+                raise self._refuse(actor, "mode", f"busy ({self._job_name}); cancel it first")
+            self.mode = mode or self.mode
+            self.selection = selection or self.selection
+            self.strategy = strategy or self.strategy
+            self._emit("mode", mode=self.mode, selection=self.selection, strategy=self.strategy)
+            summary = f"{self.mode} {self.selection} {self.strategy}"
+            self._record(actor, "mode", "ok", message=summary)
+
+    def reset_scene(self, actor: Actor, scene: Scene) -> None:
+        """Replace the world with `scene`: a fresh robot at the scene's start pose."""
+        with self._lock:
+            if self.busy:
+                raise self._refuse(actor, "scene", f"busy ({self._job_name}); cancel it first")
+            if self.estopped:
+                raise self._refuse(actor, "scene", "the e-stop is latched; reset it first")
+            old = self.robot
+            new = SimRobot(scene, realtime=True, settings=self.settings)
+            self._attach(new)
+            old.close()
+            for fn in list(self._scene_listeners):
+                fn(new)
+            self._emit("scene", scene=scene.name, message=f"Scene {scene.name!r} loaded.")
+            self._record(actor, "scene", "ok", message=scene.name)
+
+    # --- the jobs (worker thread) -----------------------------------------------------------
+
+    def _perceive_job(self) -> None:
+        frames = self.robot.capture()
+        perception = perceive(frames, settings=self.settings.perception)
+        self._cloud, self._cloud_pose = perception.cloud, self.robot.base_pose()
+        with self._lock:
+            self.task.timings = dict(perception.timings)
+            if self._cancel.is_set():
+                self.robot.laser.off()
+                self.task = _Task()
+                self._set(TaskState.IDLE, "Cancelled.")
+                return
+            if perception.failure is not None:
+                yaw, pitch = self.robot.laser.state.yaw, self.robot.laser.state.pitch
+                self.robot.laser.aim(yaw, pitch)  # back to the single aiming beam
+                self._fail(perception.failure, TaskState.AIMING)
+                return
+            self.robot.laser.off()
+            self.task.perception = perception
+            self._projection = highlight_points(self.projector, perception.target_points)
+            self._set(TaskState.PERCEIVED, "Target found. Finding grasps.")
+        self._grasp_job()
+
+    def _grasp_job(self) -> None:
+        perception = self.task.perception
+        assert perception is not None
+        strategy = self.strategy
+        if strategy == "jeeves":
+            self._progress("Driving to the object.")
+            approached = self.behaviours.approach(perception)
+            if isinstance(approached, Failure) or not approached.ok:
+                failure = approached if isinstance(approached, Failure) else approached.failure
+                assert failure is not None
+                with self._lock:
+                    self._fail(failure, TaskState.PERCEIVED)
+                return
+            perception = approached
+            self._cloud, self._cloud_pose = perception.cloud, self.robot.base_pose()
+        found = find_grasps(
+            perception,
+            dims.UR5_READY_Q,
+            q_capture=self.robot.joint_state().q,
+            strategy="vertical" if strategy == "jeeves" else strategy,
+            settings=self.settings,
+            rng=self._rng,
+        )
+        with self._lock:
+            self.task.perception = perception
+            if self._cancel.is_set():
+                self._set(TaskState.PERCEIVED, "Cancelled.")
+                return
+            if isinstance(found, Failure):
+                self._fail(found, TaskState.PERCEIVED)
+                return
+            self.task.timings.update(found.timings)
+            self.task.grasps = found
+            self.task.cursor = GraspCursor(found.clusters)
+            self._set(TaskState.GRASPS_READY, f"Grasps ready: {self.task.cursor.describe()}.")
+
+    def _pick_job(self, order: list[Grasp]) -> None:
+        grasps = self.task.grasps
+        assert grasps is not None
+        out = self.behaviours.pick(grasps, order)
+        self.task.timings.update(out.timings)
+        if not out.ok:
+            assert out.failure is not None
+            self._end_badly(out.failure)
+            return
+        with self._lock:
+            self._set(TaskState.HOLDING, "Holding the object.")
+        if self.mode == "pick_and_drop":
+            self._drop_job()
+            return
+        held = self.behaviours.held
+        assert held is not None
+        raised = self.behaviours.go_to(
+            dims.UR5_HIGH_READY_Q, held.surroundings, "raising", payload=held.points_tcp
+        )
+        if not raised.ok:
+            assert raised.failure is not None
+            self._end_badly(raised.failure)
+            return
+        with self._lock:
+            self._set(TaskState.AWAITING_PLACE, "Mark where to put it, then confirm.")
+
+    def _drop_job(self) -> None:
+        out = self.behaviours.drop_in_basket()
+        if not out.ok:
+            assert out.failure is not None
+            self._end_badly(out.failure)
+            return
+        self._stow_and_rest("Dropped in the basket.")
+
+    def _place_job(self) -> None:
+        with self._lock:
+            self._set(TaskState.PLACING, "Looking at the place mark.")
+        frames = self.robot.capture()
+        self.robot.laser.off()
+        mark = detect_mark(frames, self.settings.perception)
+        if isinstance(mark, Failure):
+            with self._lock:
+                self.robot.laser.aim(self.robot.laser.state.yaw, self.robot.laser.state.pitch)
+                self._fail(mark, TaskState.AWAITING_PLACE)
+            return
+        cloud = fuse(frames, self.settings.perception)
+        self._cloud, self._cloud_pose = cloud, self.robot.base_pose()
+        self.task.place_mark = mark.point
+        self._projection = highlight_disc(self.projector, mark.point)
+        self._progress("Placing.")
+        out = self.behaviours.place(cloud, mark.point)
+        if not out.ok:
+            assert out.failure is not None
+            self._end_badly(out.failure)
+            return
+        self._stow_and_rest("Placed.")
+
+    def _stow_and_rest(self, message: str) -> None:
+        out = self.behaviours.stow()
+        with self._lock:
+            self.task = _Task()
+            self._projection = None
+            if out.ok:
+                self._set(TaskState.IDLE, f"{message} Ready.")
+            else:
+                assert out.failure is not None
+                self._fail(out.failure, TaskState.IDLE)
+
+    def _end_badly(self, failure: Failure) -> None:
+        """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
+        hand is kept (never dropped from height): the arm raises it and the session holds."""
+        cancelled = self._cancel.is_set()
+        if cancelled:
+            failure = Failure("execute", "Cancelled by the operator.")
+        self._cancel.clear()  # the retreat itself must be allowed to move
+        if self.estopped:
+            with self._lock:
+                self._fail(failure, self._resting_state())
+            return
+        b = self.behaviours
+        if b.held is not None and self.robot.gripper_state().holding:
+            self._progress("Raising what the hand holds.")
+            b.go_to(
+                dims.UR5_HIGH_READY_Q, b.held.surroundings, "raising", payload=b.held.points_tcp
+            )
+        else:
+            if self.robot.gripper_state().closed:
+                self.robot.gripper(False)
+                self.robot.sleep(GRIPPER_TIME)
+            b.held = None
+            self._progress("Returning the arm.")
+            b.stow()
+        with self._lock:
+            if cancelled:
+                self._cancel.set()  # so the journal records the job as cancelled
+            state = self._resting_state()
+            if state == TaskState.IDLE:
+                self.task = _Task()
+                self._projection = None
+            self._fail(failure, state)
+
+    def _resting_state(self) -> TaskState:
+        holding = self.behaviours.held is not None and self.robot.gripper_state().holding
+        return TaskState.HOLDING if holding else TaskState.IDLE
+
+    # --- the watchdog ------------------------------------------------------------------------
+
+    def _watch(self) -> None:
+        """Halt motion commanded by a lease holder who has gone silent (no heartbeat for
+        `watchdog_s`, or its websocket dropped)."""
+        limit = self.settings.server.watchdog_s
+        while not self._closing.wait(0.02):
+            with self._lock:
+                token = self._motion_token if self.busy else None
+                driving = time.monotonic() < self._drive_until and self._drive_token is not None
+                drive_token = self._drive_token if driving else None
+            for tok, what in ((token, "motion"), (drive_token, "drive")):
+                if tok is None or self.lease.silent_for(tok) <= limit:
+                    continue
+                self.robot.halt()
+                with self._lock:
+                    if what == "motion":
+                        self._cancel.set()
+                        self._motion_token = None
+                    self._drive_until = 0.0
+                    self.message = "The controller went silent: motion halted."
+                    self._emit("watchdog", message=self.message)
+                    self._record(SYSTEM, "watchdog", "halted", message=self.message)
+
+    # --- reads ------------------------------------------------------------------------------
+
+    def _to_base(
+        self, v: np.ndarray, frame: Literal["base", "world"], *, direction: bool = False
+    ) -> np.ndarray:
+        if v.shape != (3,) or not np.all(np.isfinite(v)):
+            raise ValueError("a point or direction must be 3 finite numbers")
+        if frame == "base":
+            return v
+        T = invert(planar_pose(*self.robot.base_pose()))
+        return T[:3, :3] @ v if direction else T[:3, :3] @ v + T[:3, 3]
+
+    def cloud(self) -> FusedCloud:
+        """The latest fused cloud in `base`; captured afresh when the scooter moved since."""
+        pose = self.robot.base_pose()
+        cloud, at = self._cloud, self._cloud_pose
+        if cloud is None or at is None or np.max(np.abs(at - pose)) > 1e-3:
+            cloud = fuse(self.robot.capture(), self.settings.perception)
+            self._cloud, self._cloud_pose = cloud, pose
+        return cloud
+
+    def cloud_bytes(self, voxel: float | None = None) -> bytes:
+        """The cloud in the compact binary form of GET /cloud (see `CLOUD_FORMAT`)."""
+        cloud = voxel_downsample(self.cloud(), voxel or self.settings.server.cloud_voxel)
+        n = len(cloud)
+        header = np.array([n], dtype="<u4").tobytes()
+        return CLOUD_MAGIC + header + cloud.points.astype("<f4").tobytes()
+
+    def projection_png(self) -> bytes:
+        """The projector image as PNG: the target (or the place spot) white, the rest black."""
+        from PIL import Image
+
+        img = self._projection
+        if img is None:
+            img = np.zeros((self.projector.height, self.projector.width), np.uint8)
+        buf = io.BytesIO()
+        Image.fromarray(img, mode="L").save(buf, format="PNG", optimize=False, compress_level=1)
+        return buf.getvalue()
+
+    def status(self) -> dict[str, Any]:
+        """Everything a console shows, as JSON-ready values. Cheap: read at 30 Hz."""
+        snap = self.robot.sim.snapshot()
+        laser = self.robot.laser.state
+        with self._lock:
+            task = self.task
+            cursor = task.cursor
+            perception = task.perception
+            mark = perception.mark.point if perception is not None and perception.mark else None
+            target = perception.target_points if perception is not None else None
+            lease = self.lease.info()
+            out: dict[str, Any] = {
+                "state": self.state.value,
+                "busy": self.busy,
+                "job": self._job_name if self.busy else None,
+                "message": self.message,
+                "mode": self.mode,
+                "selection": self.selection,
+                "strategy": self.strategy,
+                "estopped": snap.estopped,
+                "sim_time": round(snap.time, 4),
+                "rtf": round(snap.rtf, 3),
+                "joints": {"q": _vec(snap.arm_q), "qd": _vec(snap.arm_qd)},
+                "base_pose": _vec(snap.base_pose),
+                "gripper": {
+                    "width": round(snap.gripper_width, 4),
+                    "force": round(snap.gripper_force, 2),
+                    "closed": snap.gripper_closed,
+                    "holding": snap.holding,
+                },
+                "laser": {
+                    "on": laser.on,
+                    "confirmed": laser.confirmed,
+                    "yaw": round(laser.yaw, 4),
+                    "pitch": round(laser.pitch, 4),
+                },
+                "mark": _vec(mark),
+                "place_mark": _vec(task.place_mark),
+                "target": None
+                if target is None or len(target) == 0
+                else {"points": len(target), "centroid": _vec(target.mean(axis=0))},
+                "grasps": None
+                if cursor is None
+                else {
+                    "clusters": len(cursor.clusters.clusters),
+                    "sizes": [len(c) for c in cursor.clusters.clusters],
+                    "cluster": cursor.cluster,
+                    "candidate": cursor.candidate,
+                    "describe": cursor.describe(),
+                },
+                "current": None if cursor is None else grasp_summary(cursor.current),
+                "timings": {k: round(v, 4) for k, v in task.timings.items()},
+                "failure": None
+                if self.failure is None
+                else {"kind": self.failure.kind, "message": self.failure.message},
+                "lease": {"held": lease.held, "holder": lease.holder, "source": lease.source},
+            }
+        return out
+
+
+#: GET /cloud: b"LPC1", then the point count N as uint32, then N x 3 float32 (x, y, z) in
+#: `base` (m), all little-endian.
+CLOUD_MAGIC = b"LPC1"
+CLOUD_FORMAT = "LPC1 | uint32 N | N x (float32 x, y, z) in base, metres, little-endian"
+
+
+def decode_cloud(data: bytes) -> np.ndarray:
+    """The (N, 3) float32 points of a GET /cloud body; ValueError if it is not one."""
+    if data[:4] != CLOUD_MAGIC or len(data) < 8:
+        raise ValueError("not a laserpick cloud (bad magic)")
+    n = int(np.frombuffer(data[4:8], dtype="<u4")[0])
+    if len(data) != 8 + 12 * n:
+        raise ValueError(f"a cloud of {n} points needs {8 + 12 * n} bytes, got {len(data)}")
+    return np.frombuffer(data[8:], dtype="<f4").reshape(n, 3)

@@ -1,0 +1,355 @@
+"""The deployment room: deploy/nginx/laserpick.conf in front of a real `laserpick serve`.
+
+The real nginx binary (Debian's nginx-light, installed by scripts/bootstrap.sh) runs as the
+current user with the committed site file, rewritten only where a test must: its listen ports
+become free loopback ports (the IPv6 listens go), its certificate becomes a self-signed one
+made here with the `openssl` CLI, and its upstreams point at the live server's ports. Each
+rewrite is asserted to have happened exactly as often as expected, so a change to the
+committed file that these regexes no longer match fails here instead of testing nothing.
+
+Through nginx, over HTTPS verified against that certificate:
+1. plain HTTP answers 301 to https;
+2. `/` (the console page) and `/api/v1/health` (JSON) come from the app, with the security
+   headers added;
+3. the `/api/v1/events` websocket upgrades, says hello, and streams state frames at its pace
+   (no proxy buffering), with a heartbeat sent along the way;
+4. `/viser/` serves viser's client page (byte for byte what viser serves directly), and
+   viser's websocket upgrades with its `viser-v<version>` subprotocol at `/viser` (where
+   viser's client connects from a page at /viser/) and at `/viser/`, and delivers messages.
+"""
+
+from __future__ import annotations
+
+import http.client
+import json
+import os
+import queue
+import re
+import shutil
+import socket
+import ssl
+import subprocess
+import sys
+import threading
+import time
+import urllib.request
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SITE_CONF = REPO / "deploy" / "nginx" / "laserpick.conf"
+NGINX = "/usr/sbin/nginx"
+START_TIMEOUT = 90.0
+
+pytestmark = [
+    pytest.mark.skipif(
+        not os.access(NGINX, os.X_OK),
+        reason=f"no nginx at {NGINX} (scripts/bootstrap.sh installs Debian's nginx-light)",
+    ),
+    pytest.mark.skipif(shutil.which("openssl") is None, reason="no `openssl` CLI to make a cert"),
+    pytest.mark.timeout(240),
+]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def _wait_for_port(port: int, proc: subprocess.Popen, timeout: float) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if proc.poll() is not None:
+            raise AssertionError(f"process exited with {proc.returncode} before port {port}")
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return
+        except OSError:
+            time.sleep(0.05)
+    raise AssertionError(f"nothing listening on 127.0.0.1:{port} after {timeout} s")
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    """Terminate, then kill if it does not go within 10 s."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(5)
+
+
+def _sub(pattern: str, repl: str, text: str, count: int) -> str:
+    """re.subn that insists on exactly `count` replacements (multiline patterns)."""
+    new, n = re.subn(pattern, repl, text, flags=re.MULTILINE)
+    assert n == count, f"expected {count} match(es) of {pattern!r} in {SITE_CONF}, found {n}"
+    return new
+
+
+def rewrite_site(
+    conf: str,
+    *,
+    http_port: int,
+    https_port: int,
+    cert: Path,
+    key: Path,
+    api_port: int,
+    viser_port: int,
+) -> str:
+    """The committed site file with only ports and certificate paths changed."""
+    # IPv6 listens go (the test binds loopback IPv4 only; both would collide once rewritten).
+    conf = _sub(r"^[ \t]*listen[ \t]+\[::\]:(?:80|443)\b[^;]*;[ \t]*\n", "", conf, 2)
+    conf = _sub(r"\blisten[ \t]+80;", f"listen 127.0.0.1:{http_port};", conf, 1)
+    conf = _sub(r"\blisten[ \t]+443\b", f"listen 127.0.0.1:{https_port}", conf, 1)
+    conf = _sub(r"\bssl_certificate[ \t]+[^;\s]+;", f"ssl_certificate {cert};", conf, 1)
+    conf = _sub(r"\bssl_certificate_key[ \t]+[^;\s]+;", f"ssl_certificate_key {key};", conf, 1)
+    conf = _sub(
+        r"(upstream[ \t]+laserpick_api[ \t]*\{\s*server[ \t]+)127\.0\.0\.1:8000;",
+        rf"\g<1>127.0.0.1:{api_port};",
+        conf,
+        1,
+    )
+    conf = _sub(
+        r"(upstream[ \t]+laserpick_viser[ \t]*\{\s*server[ \t]+)127\.0\.0\.1:8080;",
+        rf"\g<1>127.0.0.1:{viser_port};",
+        conf,
+        1,
+    )
+    # Nothing else may still point at the production ports.
+    assert not re.search(r"\blisten[ \t]+(?!127\.0\.0\.1:)", conf), conf
+    assert ":8000;" not in conf and ":8080;" not in conf, conf
+    return conf
+
+
+def nginx_main_conf(root: Path, site: Path) -> str:
+    """A top-level nginx.conf that keeps every file nginx writes inside `root`."""
+    return f"""\
+daemon off;
+worker_processes 1;
+pid {root}/nginx.pid;
+error_log {root}/error.log info;
+events {{
+    worker_connections 128;
+}}
+http {{
+    access_log {root}/access.log;
+    client_body_temp_path {root}/client_body;
+    proxy_temp_path {root}/proxy;
+    fastcgi_temp_path {root}/fastcgi;
+    uwsgi_temp_path {root}/uwsgi;
+    scgi_temp_path {root}/scgi;
+    include {site};
+}}
+"""
+
+
+@dataclass
+class Stack:
+    https_port: int
+    http_port: int
+    api_port: int
+    viser_port: int
+    tls: ssl.SSLContext
+
+    def get(self, path: str) -> tuple[int, dict[str, str], bytes]:
+        conn = http.client.HTTPSConnection(
+            "127.0.0.1", self.https_port, context=self.tls, timeout=10
+        )
+        try:
+            conn.request("GET", path)
+            resp = conn.getresponse()
+            return resp.status, {k.lower(): v for k, v in resp.getheaders()}, resp.read()
+        finally:
+            conn.close()
+
+
+class _Serve:
+    """`laserpick serve` in a subprocess; stdout read by a thread, stderr to a file."""
+
+    def __init__(self, tmp: Path, api_port: int, viser_port: int) -> None:
+        env = dict(os.environ)
+        env["MUJOCO_GL"] = "egl"
+        env.pop("LASERPICK_OPERATOR_PASSWORD", None)
+        env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
+        self.stderr_path = tmp / "serve.stderr"
+        self._stderr = self.stderr_path.open("w")
+        self.proc = subprocess.Popen(
+            [
+                *[sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"],
+                *["--port", str(api_port), "--viser-port", str(viser_port)],
+                *["--scene", "isolation", "--journal", str(tmp / "j.sqlite3")],
+            ],
+            cwd=REPO,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=self._stderr,
+            text=True,
+        )
+        self.lines: queue.Queue[str] = queue.Queue()
+        self.output: list[str] = []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            self.output.append(line)
+            self.lines.put(line)
+
+    def log(self) -> str:
+        self._stderr.flush()
+        return "".join(self.output) + "--- stderr ---\n" + self.stderr_path.read_text()[-4000:]
+
+    def wait_ready(self, timeout: float) -> str:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            try:
+                line = self.lines.get(timeout=0.2)
+            except queue.Empty:
+                if self.proc.poll() is not None:
+                    break
+                continue
+            if line.startswith("laserpick: console at "):
+                return line.split(" at ", 1)[1].strip()
+        raise AssertionError(f"`laserpick serve` never said 'console at':\n{self.log()}")
+
+    def close(self) -> None:
+        _stop(self.proc)
+        self._stderr.close()
+
+
+@pytest.fixture(scope="module")
+def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
+    tmp = tmp_path_factory.mktemp("deploy")
+    cert, key = tmp / "cert.pem", tmp / "key.pem"
+    subprocess.run(
+        [
+            *["openssl", "req", "-x509", "-nodes", "-days", "2", "-newkey", "ec"],
+            *["-pkeyopt", "ec_paramgen_curve:prime256v1", "-subj", "/CN=127.0.0.1"],
+            *["-addext", "subjectAltName=IP:127.0.0.1"],
+            *["-keyout", str(key), "-out", str(cert)],
+        ],
+        check=True,
+        capture_output=True,
+    )
+    tls = ssl.create_default_context(cafile=str(cert))
+
+    api_port, viser_port, http_port, https_port = (_free_port() for _ in range(4))
+    site = tmp / "laserpick.conf"
+    site.write_text(
+        rewrite_site(
+            SITE_CONF.read_text(),
+            http_port=http_port,
+            https_port=https_port,
+            cert=cert,
+            key=key,
+            api_port=api_port,
+            viser_port=viser_port,
+        )
+    )
+    main_conf = tmp / "nginx.conf"
+    main_conf.write_text(nginx_main_conf(tmp, site))
+    nginx = [NGINX, "-p", str(tmp), "-e", str(tmp / "error.log"), "-c", str(main_conf)]
+    check = subprocess.run([*nginx, "-t"], capture_output=True, text=True)
+    assert check.returncode == 0, f"nginx rejects the config:\n{check.stderr}"
+
+    serve = _Serve(tmp, api_port, viser_port)
+    web: subprocess.Popen | None = None
+    try:
+        url = serve.wait_ready(START_TIMEOUT)
+        assert f":{api_port}" in url, f"console URL {url!r} is not on --port {api_port}"
+        web = subprocess.Popen(nginx, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        _wait_for_port(https_port, web, timeout=10)
+        _wait_for_port(viser_port, serve.proc, timeout=10)
+        yield Stack(https_port, http_port, api_port, viser_port, tls)
+        assert serve.proc.poll() is None, f"`laserpick serve` died:\n{serve.log()}"
+    finally:
+        if web is not None:
+            _stop(web)
+        serve.close()
+        err = tmp / "error.log"
+        if err.exists():
+            print("--- nginx error.log (tail) ---\n" + err.read_text()[-3000:])
+
+
+def test_http_redirects_to_https(stack: Stack) -> None:
+    conn = http.client.HTTPConnection("127.0.0.1", stack.http_port, timeout=10)
+    try:
+        conn.request("GET", "/api/v1/health?x=1")
+        resp = conn.getresponse()
+        resp.read()
+    finally:
+        conn.close()
+    assert resp.status == 301
+    assert resp.getheader("Location") == "https://127.0.0.1/api/v1/health?x=1"
+
+
+def test_page_and_health_through_the_proxy(stack: Stack) -> None:
+    status, headers, body = stack.get("/api/v1/health")
+    assert status == 200, body[:500]
+    assert headers["content-type"].startswith("application/json")
+    assert isinstance(json.loads(body), dict)
+    # The security headers ride on every response.
+    assert headers["strict-transport-security"].startswith("max-age=")
+    assert headers["x-content-type-options"] == "nosniff"
+    assert headers["x-frame-options"] == "SAMEORIGIN"
+    assert "server" not in headers or "/" not in headers["server"]  # server_tokens off
+
+    status, headers, body = stack.get("/")
+    assert status == 200, body[:500]
+    assert headers["content-type"].startswith("text/html")
+
+
+def test_events_websocket_streams_state_through_the_proxy(stack: Stack) -> None:
+    from websockets.sync.client import connect
+
+    url = f"wss://127.0.0.1:{stack.https_port}/api/v1/events"
+    with connect(url, ssl=stack.tls, open_timeout=10, close_timeout=2) as ws:
+        hello = json.loads(ws.recv(timeout=10))
+        assert hello["type"] == "hello", hello
+        t0 = time.monotonic()
+        states = 0
+        while states < 15:
+            msg = json.loads(ws.recv(timeout=5))
+            if msg["type"] == "state":
+                states += 1
+                if states == 5:
+                    ws.send(json.dumps({"type": "heartbeat"}))
+        elapsed = time.monotonic() - t0
+    # 15 frames at 30 Hz is half a second; a buffering proxy would hold them back in bulk.
+    assert elapsed < 4.0, f"15 state frames took {elapsed:.1f} s through the proxy"
+
+
+def test_viser_page_through_the_proxy(stack: Stack) -> None:
+    status, headers, body = stack.get("/viser/")
+    assert status == 200
+    assert headers["content-type"].startswith("text/html")
+    assert b"<title>Viser</title>" in body
+    with urllib.request.urlopen(f"http://127.0.0.1:{stack.viser_port}/", timeout=10) as r:
+        assert body == r.read(), "the proxied /viser/ page differs from viser's own"
+    # A plain GET of /viser (no slash) is sent to the page.
+    status, headers, _ = stack.get("/viser")
+    assert status == 301
+    assert headers["location"].endswith("/viser/")
+
+
+@pytest.mark.parametrize("path", ["/viser", "/viser/"])
+def test_viser_websocket_through_the_proxy(stack: Stack, path: str) -> None:
+    from viser import __version__ as viser_version
+    from websockets.sync.client import connect
+
+    # viser's client asks for the `viser-v<version>` subprotocol and the server drops a
+    # connection whose version does not match; a page at /viser/ connects to wss://.../viser.
+    protocol = f"viser-v{viser_version}"
+    url = f"wss://127.0.0.1:{stack.https_port}{path}"
+    with connect(
+        url, ssl=stack.tls, subprotocols=[protocol], open_timeout=10, close_timeout=2
+    ) as ws:
+        assert ws.subprotocol == protocol
+        first = ws.recv(timeout=10)
+        assert isinstance(first, bytes) and first, "viser sent an empty first message"
+        ws.recv(timeout=10)  # and keeps talking
