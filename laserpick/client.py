@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import threading
 import time
 from collections.abc import Callable
@@ -28,6 +29,7 @@ from websockets.exceptions import WebSocketException
 from websockets.sync.client import ClientConnection, connect
 
 API = "/api/v1"
+log = logging.getLogger(__name__)
 
 
 class ApiError(Exception):
@@ -169,6 +171,8 @@ class Client:
                 self._on_message(json.loads(text))
         except (WebSocketException, OSError):
             pass  # the server went away; requests will say so
+        except Exception:  # without heartbeats the server halts motion: say why
+            log.exception("the events thread failed; heartbeats have stopped")
 
     def _on_message(self, msg: dict[str, Any]) -> None:
         seq = msg.get("seq")

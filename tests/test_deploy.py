@@ -23,14 +23,11 @@ from __future__ import annotations
 import http.client
 import json
 import os
-import queue
 import re
 import shutil
 import socket
 import ssl
 import subprocess
-import sys
-import threading
 import time
 import urllib.request
 from collections.abc import Iterator
@@ -38,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from serve_process import ServeProcess, free_port, stop_process
 
 REPO = Path(__file__).resolve().parents[1]
 SITE_CONF = REPO / "deploy" / "nginx" / "laserpick.conf"
@@ -54,12 +52,6 @@ pytestmark = [
 ]
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 def _wait_for_port(port: int, proc: subprocess.Popen, timeout: float) -> None:
     end = time.monotonic() + timeout
     while time.monotonic() < end:
@@ -71,17 +63,6 @@ def _wait_for_port(port: int, proc: subprocess.Popen, timeout: float) -> None:
         except OSError:
             time.sleep(0.05)
     raise AssertionError(f"nothing listening on 127.0.0.1:{port} after {timeout} s")
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    """Terminate, then kill if it does not go within 10 s."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
 
 
 def _sub(pattern: str, repl: str, text: str, count: int) -> str:
@@ -168,60 +149,6 @@ class Stack:
             conn.close()
 
 
-class _Serve:
-    """`laserpick serve` in a subprocess; stdout read by a thread, stderr to a file."""
-
-    def __init__(self, tmp: Path, api_port: int, viser_port: int) -> None:
-        env = dict(os.environ)
-        env["MUJOCO_GL"] = "egl"
-        env.pop("LASERPICK_OPERATOR_PASSWORD", None)
-        env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
-        self.stderr_path = tmp / "serve.stderr"
-        self._stderr = self.stderr_path.open("w")
-        self.proc = subprocess.Popen(
-            [
-                *[sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"],
-                *["--port", str(api_port), "--viser-port", str(viser_port)],
-                *["--scene", "isolation", "--journal", str(tmp / "j.sqlite3")],
-            ],
-            cwd=REPO,
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=self._stderr,
-            text=True,
-        )
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.output: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.output.append(line)
-            self.lines.put(line)
-
-    def log(self) -> str:
-        self._stderr.flush()
-        return "".join(self.output) + "--- stderr ---\n" + self.stderr_path.read_text()[-4000:]
-
-    def wait_ready(self, timeout: float) -> str:
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            try:
-                line = self.lines.get(timeout=0.2)
-            except queue.Empty:
-                if self.proc.poll() is not None:
-                    break
-                continue
-            if line.startswith("laserpick: console at "):
-                return line.split(" at ", 1)[1].strip()
-        raise AssertionError(f"`laserpick serve` never said 'console at':\n{self.log()}")
-
-    def close(self) -> None:
-        _stop(self.proc)
-        self._stderr.close()
-
-
 @pytest.fixture(scope="module")
 def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
     tmp = tmp_path_factory.mktemp("deploy")
@@ -238,7 +165,7 @@ def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
     )
     tls = ssl.create_default_context(cafile=str(cert))
 
-    api_port, viser_port, http_port, https_port = (_free_port() for _ in range(4))
+    api_port, viser_port, http_port, https_port = (free_port() for _ in range(4))
     site = tmp / "laserpick.conf"
     site.write_text(
         rewrite_site(
@@ -257,11 +184,10 @@ def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
     check = subprocess.run([*nginx, "-t"], capture_output=True, text=True)
     assert check.returncode == 0, f"nginx rejects the config:\n{check.stderr}"
 
-    serve = _Serve(tmp, api_port, viser_port)
+    serve = ServeProcess(tmp, api_port=api_port, viser_port=viser_port)
     web: subprocess.Popen | None = None
     try:
-        url = serve.wait_ready(START_TIMEOUT)
-        assert f":{api_port}" in url, f"console URL {url!r} is not on --port {api_port}"
+        serve.start(START_TIMEOUT)
         web = subprocess.Popen(nginx, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         _wait_for_port(https_port, web, timeout=10)
         _wait_for_port(viser_port, serve.proc, timeout=10)
@@ -269,7 +195,7 @@ def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
         assert serve.proc.poll() is None, f"`laserpick serve` died:\n{serve.log()}"
     finally:
         if web is not None:
-            _stop(web)
+            stop_process(web)
         serve.close()
         err = tmp / "error.log"
         if err.exists():

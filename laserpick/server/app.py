@@ -118,7 +118,11 @@ class EventHub:
     def broadcast(self, message: dict[str, Any]) -> None:
         self.seq += 1
         message["seq"] = self.seq
-        text = json.dumps(message, separators=(",", ":"))
+        try:
+            text = json.dumps(message, separators=(",", ":"), allow_nan=False)
+        except (TypeError, ValueError):  # a bug upstream must not end the stream
+            log.exception("cannot encode a %s message", message.get("type"))
+            return
         for client in list(self.clients):
             self.offer(client, text)
 
@@ -212,19 +216,30 @@ def create_app(
 
     Commander = Annotated[Actor, Depends(actor)]
 
-    def ok() -> S.Ok:
-        return S.Ok(state=session.state.value, message=session.message)
+    def ok(taken_at: float) -> S.Ok:
+        return S.Ok(state=session.state.value, message=session.message, sim_time=taken_at)
+
+    def sim_now() -> float:
+        return session.robot.sim.snapshot().time
 
     def guarded(fn: Callable[[], object]) -> S.Ok:
+        taken_at = sim_now()
         try:
             fn()
         except Conflict as exc:
             raise HTTPException(409, {"detail": str(exc), "state": exc.state.value}) from None
         except (ValueError, IndexError) as exc:
             raise _unprocessable("body", str(exc)) from None
-        return ok()
+        return ok(taken_at)
 
-    conflict = {409: {"model": S.Refusal, "description": "Conflicts with the task state."}}
+    unauthorized = {401: {"model": S.Problem, "description": "No token, or not the lease's."}}
+    conflict = {
+        **unauthorized,
+        409: {"model": S.Refusal, "description": "Conflicts with the task state."},
+    }
+    # The token is optional here. FastAPI lists the bearer scheme as required and appends
+    # these requirements to it; the empty one makes the scheme optional in the OpenAPI.
+    token_optional: dict[str, Any] = {"security": [{}]}
 
     @app.exception_handler(HTTPException)
     async def _http_error(_request: Request, exc: HTTPException) -> JSONResponse:
@@ -342,7 +357,11 @@ def create_app(
         f"{API}/control",
         response_model=S.ControlGrant,
         tags=["control"],
-        responses={409: {"model": S.Refusal, "description": "Someone else holds control."}},
+        responses={
+            401: {"model": S.Problem, "description": "Wrong or missing operator password."},
+            409: {"model": S.Refusal, "description": "Someone else holds control."},
+        },
+        openapi_extra=token_optional,
     )
     def take_control(
         body: S.ControlRequest,
@@ -367,11 +386,11 @@ def create_app(
             watchdog_s=settings.watchdog_s,
         )
 
-    @app.delete(f"{API}/control", response_model=S.Ok, tags=["control"])
+    @app.delete(f"{API}/control", response_model=S.Ok, tags=["control"], responses=unauthorized)
     def release_control(who: Commander) -> S.Ok:
         assert who.token is not None
         session.lease.release(who.token)
-        return ok()
+        return ok(sim_now())
 
     # --- commands ------------------------------------------------------------------------
 
@@ -439,7 +458,7 @@ def create_app(
         drop the object in the basket."""
         return guarded(lambda: session.execute(who))
 
-    @app.post(f"{API}/cancel", response_model=S.Ok, tags=["task"])
+    @app.post(f"{API}/cancel", response_model=S.Ok, tags=["task"], responses=unauthorized)
     def cancel(who: Commander) -> S.Ok:
         return guarded(lambda: session.cancel(who))
 
@@ -452,14 +471,15 @@ def create_app(
         """Drive the base (a dead-man: the command lapses after `duration`, at most 0.5 s)."""
         return guarded(lambda: session.drive(who, body.v, body.w, body.duration))
 
-    @app.post(f"{API}/stop", response_model=S.Ok, tags=["motion"])
+    @app.post(f"{API}/stop", response_model=S.Ok, tags=["motion"], openapi_extra=token_optional)
     def stop(creds: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]) -> S.Ok:
         """E-stop: halt the arm and the base now, latched until `POST /stop/reset`. Needs no
         token: anyone watching may stop the robot."""
+        taken_at = sim_now()
         token = creds.credentials if creds else None
         source = session.lease.check(token) or "rest"
         session.stop(Actor(source, token))  # type: ignore[arg-type]
-        return ok()
+        return ok(taken_at)
 
     @app.post(f"{API}/stop/reset", response_model=S.Ok, tags=["motion"], responses=conflict)
     def stop_reset(who: Commander) -> S.Ok:

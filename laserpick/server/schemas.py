@@ -148,10 +148,17 @@ class Refusal(BaseModel):
     state: str
 
 
+class Problem(BaseModel):
+    """401 or 413: why the request was refused."""
+
+    detail: str
+
+
 class Ok(BaseModel):
     ok: bool = True
     state: str
     message: str
+    sim_time: float = Field(description="Robot time (s) when the command was taken.")
 
 
 class LeaseStatus(BaseModel):
