@@ -238,6 +238,12 @@ class Behaviours:
             return Outcome(
                 Failure("execute", "The gripper closed on nothing."), grasp, attempts, timings
             )
+        # Held from here on, so that a cancel or an e-stop while lifting still knows what
+        # the hand has (the object's points travel with it in later collision checks).
+        support = grasps.target[:, 2].min()
+        pts = grasps.target[thin(grasps.target, 0.02)]
+        pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
+        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)
@@ -247,13 +253,11 @@ class Behaviours:
         if failure is None and not self.robot.gripper_state().holding:
             failure = Failure("execute", "The object slipped out of the hand while lifting.")
         if failure:
-            self.robot.gripper(False)
-            self.robot.sleep(GRIPPER_TIME)
+            if not self.should_stop():  # a cancel or an e-stop keeps what the hand holds
+                self.robot.gripper(False)
+                self.robot.sleep(GRIPPER_TIME)
+                self.held = None
             return Outcome(failure, grasp, attempts, timings)
-        support = grasps.target[:, 2].min()
-        pts = grasps.target[thin(grasps.target, 0.02)]
-        pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
-        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
         self.progress("Holding the object.")
         return Outcome(None, grasp, attempts, timings)
 

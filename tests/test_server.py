@@ -192,6 +192,25 @@ def test_estop_halts_within_20_ms_and_latches(server: ServeProcess, client: Clie
     assert not client.state()["estopped"]
 
 
+def test_cancel_halts_and_retreats(server: ServeProcess, client: Client) -> None:
+    mark(client, "mug_1")
+    watcher = Watcher(server.url)
+    try:
+        client.post("/execute")
+        watcher.wait_moving()
+        client.post("/cancel")
+        state = client.settled(120)
+    finally:
+        watcher.close()
+    assert state["state"] in ("idle", "holding"), state["message"]
+    assert state["failure"]["message"] == "Cancelled by the operator."
+    assert max(abs(v) for v in state["joints"]["qd"]) < 0.01
+    if state["state"] == "idle":  # nothing in the hand: the arm went home and opened
+        assert not state["gripper"]["closed"]
+    journal = client.get("/journal", format="json")
+    assert any(e["action"] == "picking" and e["outcome"] == "cancelled" for e in journal)
+
+
 def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) -> None:
     http = requests.Session()
     grant = http.post(f"{server.url}{API}/control", json={"name": "flaky"}, timeout=10).json()

@@ -164,6 +164,7 @@ class Session:
         self.journal = journal
         self.lease = ControlLease(self.settings.server.lease_timeout_s)
         self._lock = threading.RLock()
+        self._scene_lock = threading.Lock()  #: one scene reset at a time
         self._listeners: list[Callable[[dict[str, Any]], None]] = []
         self._scene_listeners: list[Callable[[SimRobot], None]] = []
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="laserpick-session")
@@ -549,20 +550,33 @@ class Session:
             self._record(actor, "mode", "ok", message=summary)
 
     def reset_scene(self, actor: Actor, scene: Scene) -> None:
-        """Replace the world with `scene`: a fresh robot at the scene's start pose."""
-        with self._lock:
-            if self.busy:
-                raise self._refuse(actor, "scene", f"busy ({self._job_name}); cancel it first")
-            if self.estopped:
-                raise self._refuse(actor, "scene", "the e-stop is latched; reset it first")
-            old = self.robot
+        """Replace the world with `scene`: a fresh robot at the scene's start pose. The new
+        model is built outside the session's lock (it takes a second or two), so state reads
+        and the e-stop stay quick meanwhile."""
+        with self._scene_lock:
+            with self._lock:
+                self._require_scene_change(actor)
             new = SimRobot(scene, realtime=True, settings=self.settings)
-            self._attach(new)
+            with self._lock:
+                try:
+                    self._require_scene_change(actor)
+                except Conflict:
+                    new.close()
+                    raise
+                old = self.robot
+                self._attach(new)
             old.close()
             for fn in list(self._scene_listeners):
                 fn(new)
-            self._emit("scene", scene=scene.name, message=f"Scene {scene.name!r} loaded.")
-            self._record(actor, "scene", "ok", message=scene.name)
+            with self._lock:
+                self._emit("scene", scene=scene.name, message=f"Scene {scene.name!r} loaded.")
+                self._record(actor, "scene", "ok", message=scene.name)
+
+    def _require_scene_change(self, actor: Actor) -> None:
+        if self.busy:
+            raise self._refuse(actor, "scene", f"busy ({self._job_name}); cancel it first")
+        if self.estopped:
+            raise self._refuse(actor, "scene", "the e-stop is latched; reset it first")
 
     # --- the jobs (worker thread) -----------------------------------------------------------
 
@@ -570,6 +584,7 @@ class Session:
         frames = self.robot.capture()
         perception = perceive(frames, settings=self.settings.perception)
         self._cloud, self._cloud_pose = perception.cloud, self.robot.base_pose()
+        lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
         with self._lock:
             self.task.timings = dict(perception.timings)
             if self._cancel.is_set():
@@ -584,7 +599,7 @@ class Session:
                 return
             self.robot.laser.off()
             self.task.perception = perception
-            self._projection = highlight_points(self.projector, perception.target_points)
+            self._projection = lit
             self._set(TaskState.PERCEIVED, "Target found. Finding grasps.")
         self._grasp_job()
 
