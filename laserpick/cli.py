@@ -81,6 +81,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     serve.add_argument("--viser-port", type=int, default=8080, help="3D view (viser) port")
     serve.add_argument(
+        "--viser-url",
+        default=None,
+        help="URL or path where browsers reach the 3D view, when not at --viser-port on the"
+        " page's host (behind deploy/'s proxy: /viser/)",
+    )
+    serve.add_argument(
         "--journal",
         type=Path,
         default=None,
@@ -175,7 +181,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
                 "put it behind the TLS proxy (deploy/)",
                 err=True,
             )
-        app = create_app(session, viser_port=viser_port)
+        app = create_app(session, viser_port=viser_port, viser_url=args.viser_url)
         config = uvicorn.Config(
             app,
             host=args.host,

@@ -158,6 +158,7 @@ def create_app(
     session: Session,
     *,
     viser_port: int | None = None,
+    viser_url: str | None = None,
     cors_origins: list[str] | None = None,
     page: Callable[[], str] | None = None,
 ) -> FastAPI:
@@ -274,6 +275,7 @@ def create_app(
             version=__version__,
             scene=scene.name if scene is not None else "",
             viser_port=viser_port,
+            viser_url=viser_url,
             rtf=round(snap.rtf, 3),
         )
 

@@ -259,6 +259,10 @@ class Health(BaseModel):
     version: str
     scene: str
     viser_port: int | None
+    viser_url: str | None = Field(
+        description="Where the page finds the 3D view when it is not at viser_port on the"
+        " page's host (behind the TLS proxy: /viser/)."
+    )
     rtf: float
 
 
