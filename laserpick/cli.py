@@ -24,6 +24,7 @@ import asyncio
 import ipaddress
 import logging
 import os
+import signal
 import socket
 import sys
 import uuid
@@ -32,6 +33,7 @@ from pathlib import Path
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 def _say(msg: str, *, err: bool = False) -> None:
@@ -151,6 +153,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     import uvicorn
     import viser
 
+    from laserpick.console.operator_console import OperatorConsole
     from laserpick.console.viewer import SceneViewer
     from laserpick.robot.sim_robot import SimRobot
     from laserpick.server.app import create_app
@@ -159,6 +162,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     session = Session(SimRobot(scene, realtime=True), journal=journal)
     server: viser.ViserServer | None = None
     viewer: SceneViewer | None = None
+    console: OperatorConsole | None = None
     try:
         server = viser.ViserServer(
             host=args.host, port=args.viser_port, label="laserpick", verbose=False
@@ -167,11 +171,13 @@ def cmd_serve(args: argparse.Namespace) -> int:
             session.robot.sim,
             server,
             rate_hz=args.viewer_rate,
-            controls=loopback,
+            controls=False,
             shadows=args.shadows,
         )
         viewer.start()
         session.on_scene(lambda robot: viewer.set_simulation(robot.sim))
+        console = OperatorConsole(session, server, controls=loopback)
+        console.start()
         viser_port = server.get_port()
         if viser_port != args.viser_port and args.viser_port != 0:
             _say(f"port {args.viser_port} was busy; the 3D view took {viser_port}", err=True)
@@ -201,10 +207,20 @@ def cmd_serve(args: argparse.Namespace) -> int:
                 _say(f"3D view at http://{_url_host(args.host)}:{viser_port}/")
             await task
 
-        asyncio.run(serve())  # uvicorn handles SIGINT and SIGTERM: a graceful shutdown
+        # uvicorn turns SIGINT and SIGTERM into a graceful shutdown, then raises the signal
+        # again with the handlers it found; with these no-op handlers in place, that second
+        # signal ends nothing, and the cleanup below (halt, journal) still runs.
+        previous = {sig: signal.signal(sig, lambda *_: None) for sig in STOP_SIGNALS}
+        try:
+            asyncio.run(serve())
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
         _say("shutting down")
         return 0 if api.started else 1
     finally:
+        if console is not None:
+            console.stop()
         if viewer is not None:
             viewer.stop()
         session.close()

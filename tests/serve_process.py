@@ -44,12 +44,14 @@ class ServeProcess:
         api_port: int | None = None,
         viser_port: int | None = None,
         env: dict[str, str] | None = None,
+        extra_args: tuple[str, ...] = (),
     ) -> None:
         self.tmp = tmp
         self.api_port = api_port or free_port()
         self.viser_port = viser_port or free_port()
         self.journal = tmp / "journal.sqlite3"
         self.url = f"http://127.0.0.1:{self.api_port}"
+        self.viser_url = f"http://127.0.0.1:{self.viser_port}"
         full_env = dict(os.environ)
         full_env["MUJOCO_GL"] = "egl"
         full_env.pop("LASERPICK_OPERATOR_PASSWORD", None)
@@ -62,6 +64,7 @@ class ServeProcess:
                 *[sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"],
                 *["--port", str(self.api_port), "--viser-port", str(self.viser_port)],
                 *["--scene", scene, "--journal", str(self.journal)],
+                *extra_args,
             ],
             cwd=REPO,
             env=full_env,

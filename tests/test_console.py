@@ -1,8 +1,9 @@
 """The viser console and the `laserpick serve` command.
 
-1. `laserpick serve` in a real subprocess, opened in headless Chromium: the scene renders
-   (the scooter's red shell is on screen among several other colours), the Pause button
-   pauses it, and SIGTERM ends the server cleanly. The screenshot: test-artifacts/console.png.
+1. `laserpick serve` in a real subprocess, its 3D view opened in headless Chromium: the scene
+   renders, a click on an object aims and a second confirms the mark, the lit target and the
+   grasp outlines show, STOP latches the e-stop, and SIGTERM ends the server cleanly. The
+   screenshot: test-artifacts/console.png.
 2. The viewer's moving-body nodes follow the simulation (headless sim, one update by hand).
 3. Bad scene names and non-loopback hosts are refused with exit code 2 and a reason.
 """
@@ -11,19 +12,20 @@ from __future__ import annotations
 
 import base64
 import os
-import queue
 import signal
 import socket
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from serve_process import ServeProcess
 
+from laserpick.client import Client
 from laserpick.console import headless_chromium
+from laserpick.console.viewer import default_view_pixel
 
 REPO = Path(__file__).resolve().parents[1]
 ARTIFACTS = REPO / "test-artifacts"
@@ -49,8 +51,9 @@ def _laserpick(*args: str) -> list[str]:
 
 
 # Colour statistics of a PNG, computed in the browser (no image library needed here):
-# pixels of the scooter's red shell, and the number of distinct colours (4 bits per channel)
-# that cover at least 0.2 % of the image.
+# the shares of pixels of the scooter's red shell, of the projector's yellow light and of
+# green grasp outlines, and the number of distinct colours (4 bits per channel) that cover at
+# least 0.2 % of the image.
 _PNG_STATS_JS = """
 async (b64) => {
   const img = new Image();
@@ -63,118 +66,93 @@ async (b64) => {
   const d = ctx.getImageData(0, 0, c.width, c.height).data;
   const n = c.width * c.height;
   const bins = new Map();
-  let red = 0;
+  let red = 0, lit = 0, green = 0;
   for (let i = 0; i < d.length; i += 4) {
     const r = d[i], g = d[i + 1], b = d[i + 2];
     if (r > 120 && r - g > 80 && r - b > 80 && Math.abs(g - b) < 40) red++;
+    if (r > 230 && g > 210 && b > 80 && b < 170) lit++;  // the projector's yellow light
+    if (g > 150 && g - r > 60 && g - b > 80) green++;  // a high-scoring grasp outline
     const k = ((r >> 4) << 8) | ((g >> 4) << 4) | (b >> 4);
     bins.set(k, (bins.get(k) || 0) + 1);
   }
   let colours = 0;
   for (const v of bins.values()) if (v >= 0.002 * n) colours++;
-  return { red: red / n, colours: colours, width: c.width, height: c.height };
+  return {
+    red: red / n, lit: lit / n, green: green / n, colours: colours,
+    width: c.width, height: c.height,
+  };
 }
 """
 
 
-class _Server:
-    """`laserpick serve` in a subprocess, with its output collected by a reader thread."""
-
-    def __init__(self, *args: str) -> None:
-        self.proc = subprocess.Popen(
-            _laserpick("serve", *args),
-            cwd=REPO,
-            env=_env(),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            start_new_session=True,
-        )
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.output: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.output.append(line)
-            self.lines.put(line)
-
-    def wait_for_url(self, timeout: float) -> str:
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            try:
-                line = self.lines.get(timeout=0.2)
-            except queue.Empty:
-                if self.proc.poll() is not None:
-                    break
-                continue
-            if line.startswith("laserpick: console at "):
-                return line.split(" at ", 1)[1].strip()
-        raise AssertionError("no console URL printed:\n" + "".join(self.output))
-
-    def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(5)
+def _pixel_stats(page, png: bytes) -> dict:
+    return page.evaluate(_PNG_STATS_JS, base64.b64encode(png).decode())
 
 
-def test_serve_renders_in_chromium_and_stops_cleanly() -> None:
+def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: Path) -> None:
+    """The 3D view of a live server in headless Chromium: it renders; a click on the mug aims
+    the laser there and a second click confirms the mark (the state's mark lands on the
+    mug); the lit target glows and the candidates are drawn; the panel's STOP latches the
+    e-stop; SIGTERM ends the server cleanly."""
     playwright = pytest.importorskip("playwright.sync_api")
     if not Path(headless_chromium.CHROMIUM).exists():
         pytest.skip("no Chromium at /usr/bin/chromium")
-    viser_port, api_port = _free_port(), _free_port()
-    server = _Server(
-        "--scene",
-        "isolation",
-        "--viser-port",
-        str(viser_port),
-        "--port",
-        str(api_port),
-        "--no-shadows",  # SwiftShader draws twice as fast without them
-    )
+    server = ServeProcess(tmp_path, extra_args=("--no-shadows",))  # SwiftShader: 2x faster
     try:
-        url = server.wait_for_url(timeout=60)
-        assert url == f"http://127.0.0.1:{viser_port}"
+        server.start()
         ARTIFACTS.mkdir(exist_ok=True)
-        shot_path = ARTIFACTS / "console.png"
+        api = Client(server.url, name="observer")
+        mug = next(o for o in api.get("/sim/objects") if o["name"] == "mug_1")
         with playwright.sync_playwright() as p:
             browser = headless_chromium.launch(p)
             try:
                 # Software WebGL renders a frame in about a second: keep the view small.
-                page = browser.new_page(viewport={"width": 800, "height": 500})
-                page.goto(url)
-                page.get_by_text("sim time", exact=False).first.wait_for(timeout=30_000)
-                # The scene fades in and the camera settles: poll until the red scooter
-                # covers a meaningful share of the view in two shots running.
+                page = browser.new_page(viewport={"width": 900, "height": 600})
+                page.goto(server.viser_url)
+                page.get_by_role("button", name="Detect").wait_for(timeout=30_000)
+                # The scene fades in: poll until the view shows many colours twice running.
                 stats: dict = {}
-                good = 0
-                t0 = time.monotonic()
+                good, t0 = 0, time.monotonic()
                 while time.monotonic() - t0 < 45 and good < 2:
                     time.sleep(1.0)
-                    png = page.screenshot(path=str(shot_path))
-                    stats = page.evaluate(_PNG_STATS_JS, base64.b64encode(png).decode())
-                    print(f"{time.monotonic() - t0:5.1f} s: {stats}")
-                    good = good + 1 if stats["red"] > 0.02 else 0
-                # The Pause button pauses the sim; the status line says so.
-                page.get_by_role("button", name="Pause").click()
-                page.get_by_role("button", name="Resume").wait_for(timeout=10_000)
-                page.get_by_text("paused", exact=False).first.wait_for(timeout=10_000)
+                    stats = _pixel_stats(page, page.screenshot())
+                    good = good + 1 if stats["colours"] >= 6 else 0
+                assert stats["colours"] >= 6, f"the view looks blank: {stats}"
+
+                box = page.locator("canvas").first.bounding_box()
+                x, y = default_view_pixel(mug["center_base"], box["width"], box["height"])
+                page.mouse.click(box["x"] + x, box["y"] + y)
+                state = api.wait_for(lambda s: s["laser"]["on"], timeout=20)
+                assert state["state"] == "aiming"
+                page.mouse.click(box["x"] + x, box["y"] + y)  # the same spot: confirm
+                state = api.wait_for(lambda s: not s["busy"] and s["mark"], timeout=60)
+                assert state["state"] == "grasps_ready", state["message"]
+                mark = np.array(state["mark"])
+                # On the mug: within its 5 cm radius of its axis, between its base and top.
+                off = np.linalg.norm(mark[:2] - np.array(mug["position_world"][:2]))
+                assert off < 0.06 and mug["position_world"][2] < mark[2] < mug["top_base"] + 0.01
+
+                time.sleep(3.0)  # the lit cloud and the outlines reach the browser
+                png = page.screenshot(path=str(ARTIFACTS / "console.png"))
+                stats = _pixel_stats(page, png)
+                assert stats["lit"] > 0.0005, f"no lit target on screen: {stats}"
+                assert stats["green"] > 0.00005, f"no grasp outline on screen: {stats}"
+
+                page.get_by_role("button", name="STOP", exact=True).click()
+                assert api.wait_for(lambda s: s["estopped"], timeout=10)["estopped"]
             finally:
                 browser.close()
-        assert stats.get("red", 0) > 0.02, f"scooter red barely visible: {stats}"
-        assert stats["colours"] >= 6, f"the view looks blank: {stats}"
         assert server.proc.poll() is None, "server died while the browser was connected"
 
         t0 = time.monotonic()
         server.proc.send_signal(signal.SIGTERM)
-        rc = server.proc.wait(timeout=10)
-        assert rc == 0, "".join(server.output)
-        assert time.monotonic() - t0 < 5.0
+        rc = server.proc.wait(timeout=15)
+        assert rc == 0, server.log()
+        assert time.monotonic() - t0 < 10.0
         time.sleep(0.2)  # let the reader thread take the last lines
         assert any("shutting down" in line for line in server.output)
     finally:
-        server.kill()
+        server.close()
 
 
 def test_viewer_nodes_follow_the_sim() -> None:

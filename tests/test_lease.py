@@ -71,3 +71,14 @@ def test_release_frees_it_only_for_the_holder(clock: Clock) -> None:
     assert not lease.release("forged")
     assert lease.release(token)
     assert not lease.info().held
+
+
+def test_the_page_and_the_3d_view_may_take_over_from_each_other(clock: Clock) -> None:
+    lease = ControlLease(timeout=5.0, clock=clock)
+    view = lease.acquire("3D view", "console")
+    assert lease.token_of("console") == view
+    assert lease.token_of("switch") is None
+    page = lease.acquire("page", "console")  # the same operator station
+    assert page != view and not lease.holds(view)
+    with pytest.raises(LeaseHeld):
+        lease.acquire("switch adapter", "switch")  # another person's device may not

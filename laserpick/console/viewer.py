@@ -43,8 +43,8 @@ FLOOR_HALF_EXTENT = 6.0
 FLOOR_THICKNESS = 0.02
 #: Default camera in `base` (m): behind-left of the scooter and high enough to look over the
 #: basket and sensor posts at the workspace in front of it. Placed for the scooter's pose.
-CAMERA_POSITION_BASE = (-0.4, 1.9, 2.6)
-CAMERA_LOOK_AT_BASE = (1.45, -0.15, 0.45)
+CAMERA_POSITION_BASE = (1.95, 1.25, 1.45)
+CAMERA_LOOK_AT_BASE = (1.45, -0.25, 0.45)
 #: Vertical field of view of the default camera (rad).
 CAMERA_FOV = math.radians(50.0)
 #: MuJoCo's default geom rgba; a geom with this colour and a material takes the material's.
@@ -430,3 +430,18 @@ class SceneViewer:
                 next_t = time.perf_counter()  # fell behind: resync rather than burst
             elif delay > 0:
                 self._stop.wait(delay)
+
+
+def default_view_pixel(point_base: np.ndarray, width: float, height: float) -> tuple[float, float]:
+    """Where a point (m, `base`) appears in the default camera's view of `width` x `height`
+    px (a pinhole with the vertical field of view CAMERA_FOV, as three.js draws it): (x, y)
+    px from the top-left. For scripted clicks in tests and benchmarks."""
+    eye, at = np.array(CAMERA_POSITION_BASE), np.array(CAMERA_LOOK_AT_BASE)
+    forward = (at - eye) / np.linalg.norm(at - eye)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    d = np.asarray(point_base, dtype=float) - eye
+    x, y, z = d @ right, d @ up, d @ forward
+    t = math.tan(CAMERA_FOV / 2)
+    return (0.5 + 0.5 * x / (z * t * width / height)) * width, (0.5 - 0.5 * y / (z * t)) * height

@@ -29,6 +29,8 @@ from fastapi.encoders import jsonable_encoder
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from fastapi.staticfiles import StaticFiles
+from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from starlette.websockets import WebSocketDisconnect
 
@@ -42,6 +44,8 @@ from laserpick.server.session import CLOUD_FORMAT, Actor, Conflict, Session
 log = logging.getLogger(__name__)
 
 API = "/api/v1"
+#: The browser page: index.html at `/`, its stylesheet and script under `/static`.
+STATIC = Path(__file__).resolve().parents[1] / "static"
 #: Messages a slow events client may fall behind by before old state frames are dropped.
 CLIENT_QUEUE = 8
 
@@ -71,7 +75,7 @@ class BodyLimit:
             message = await receive()
             seen += len(message.get("body", b""))
             if seen > self.limit:
-                raise _BodyTooLarge
+                raise _BodyTooLarge(self.limit)
             return message
 
         try:
@@ -80,8 +84,12 @@ class BodyLimit:
             await _too_large(self.limit)(scope, receive, send)
 
 
-class _BodyTooLarge(Exception):
-    pass
+class _BodyTooLarge(HTTPException):
+    """An HTTPException, so that FastAPI's body reader passes it on (rather than answering
+    400) to the app's handler, which answers 413."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(413, f"request body larger than {limit} bytes")
 
 
 def _too_large(limit: int) -> JSONResponse:
@@ -163,7 +171,7 @@ def create_app(
     page: Callable[[], str] | None = None,
 ) -> FastAPI:
     """The app around `session`. cors_origins: allowed browser origins (default none).
-    page: returns the HTML of `/` (default a minimal page pointing at the docs)."""
+    page: returns the HTML of `/` (default `static/index.html`, the operator page)."""
     settings = session.settings.server
     hub = EventHub(session, settings.events_hz)
     session.on_event(hub.publish_threadsafe)
@@ -191,6 +199,8 @@ def create_app(
             "frame (x forward, y left, z up) unless `frame` says `world`."
         ),
         lifespan=lifespan,
+        # BodyLimit refuses a body over the limit whatever the route
+        responses={413: {"model": S.Problem, "description": "The body is over the size limit."}},
     )
     app.state.session, app.state.hub = session, hub
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
@@ -242,8 +252,11 @@ def create_app(
     # these requirements to it; the empty one makes the scheme optional in the OpenAPI.
     token_optional: dict[str, Any] = {"security": [{}]}
 
-    @app.exception_handler(HTTPException)
-    async def _http_error(_request: Request, exc: HTTPException) -> JSONResponse:
+    @app.exception_handler(StarletteHTTPException)  # FastAPI's own 400 is Starlette's
+    async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        if exc.status_code == 400:  # FastAPI could not decode the body (not UTF-8): bad input
+            error = {"loc": ("body",), "msg": str(exc.detail), "type": "json_invalid"}
+            return await _invalid(request, RequestValidationError([error]))
         body = exc.detail if isinstance(exc.detail, dict) else {"detail": exc.detail}
         return JSONResponse(body, status_code=exc.status_code, headers=exc.headers)
 
@@ -264,7 +277,13 @@ def create_app(
 
     @app.get("/", response_class=HTMLResponse, include_in_schema=False)
     def index() -> str:
-        return page() if page is not None else _MINIMAL_PAGE
+        if page is not None:
+            return page()
+        html = STATIC / "index.html"
+        return html.read_text(encoding="utf-8") if html.is_file() else _MINIMAL_PAGE
+
+    if STATIC.is_dir():
+        app.mount("/static", StaticFiles(directory=STATIC), name="static")
 
     @app.get(f"{API}/health", response_model=S.Health, tags=["read"])
     def health() -> S.Health:

@@ -22,6 +22,9 @@ import threading
 import time
 from dataclasses import dataclass
 
+#: The input source of the operator station: the page and its embedded 3D view.
+CONSOLE = "console"
+
 
 class LeaseHeld(Exception):
     """Someone else holds the lease."""
@@ -67,7 +70,10 @@ class ControlLease:
             if token is not None and self._valid(token, now):
                 self._last, self._lost = now, False
                 return token
-            if not self._lapsed(now):
+            # The page and the 3D view are one operator station: either may take over
+            # from the other (a person moving from one to the other, not a second person).
+            same_station = source == CONSOLE and self._source == CONSOLE
+            if not self._lapsed(now) and not same_station:
                 assert self._holder is not None
                 raise LeaseHeld(self._holder, self.timeout - (now - self._last))
             self._token = secrets.token_urlsafe(24)
@@ -112,6 +118,14 @@ class ControlLease:
             current = self._token
             if current is not None and hmac.compare_digest(token.encode(), current.encode()):
                 self._lost = True
+
+    def token_of(self, source: str) -> str | None:
+        """In-process use only (the 3D view acting for the page it is embedded in): the
+        current token if the holder's input source is `source`, else None."""
+        with self._lock:
+            if self._lapsed(self._clock()) or self._source != source:
+                return None
+            return self._token
 
     def holds(self, token: str) -> bool:
         with self._lock:

@@ -25,7 +25,7 @@ Source = Literal["console", "rest", "switch", "joystick", "bench"]
 
 
 class _Body(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)  # no "1" or true for 1.0
 
 
 class ControlRequest(_Body):

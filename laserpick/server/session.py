@@ -200,8 +200,9 @@ class Session:
         self.failure: Failure | None = None
         self.message = "Ready. Aim the laser at an object."
         self._projection: np.ndarray | None = None
-        self._cloud: FusedCloud | None = None
-        self._cloud_pose: np.ndarray | None = None
+        #: the last fused cloud and the scooter's pose when it was captured (one reference,
+        #: so readers on other threads never see a cloud with another capture's pose)
+        self._cloud_at: tuple[FusedCloud, np.ndarray] | None = None
 
     def close(self) -> None:
         """Halt, stop the worker and the watchdog, and close the robot."""
@@ -510,7 +511,7 @@ class Session:
                 self._projection = None
                 aiming = self.robot.laser.state.on
                 self._set(TaskState.AIMING if aiming else TaskState.IDLE, "Driving.")
-            self._cloud = None
+            self._cloud_at = None
 
     def stop(self, actor: Actor) -> None:
         """E-stop: arm and base halt within one control tick and stay halted until reset."""
@@ -583,7 +584,7 @@ class Session:
     def _perceive_job(self) -> None:
         frames = self.robot.capture()
         perception = perceive(frames, settings=self.settings.perception)
-        self._cloud, self._cloud_pose = perception.cloud, self.robot.base_pose()
+        self._cloud_at = (perception.cloud, self.robot.base_pose())
         lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
         with self._lock:
             self.task.timings = dict(perception.timings)
@@ -617,7 +618,7 @@ class Session:
                     self._fail(failure, TaskState.PERCEIVED)
                 return
             perception = approached
-            self._cloud, self._cloud_pose = perception.cloud, self.robot.base_pose()
+            self._cloud_at = (perception.cloud, self.robot.base_pose())
         found = find_grasps(
             perception,
             dims.UR5_READY_Q,
@@ -685,7 +686,7 @@ class Session:
                 self._fail(mark, TaskState.AWAITING_PLACE)
             return
         cloud = fuse(frames, self.settings.perception)
-        self._cloud, self._cloud_pose = cloud, self.robot.base_pose()
+        self._cloud_at = (cloud, self.robot.base_pose())
         self.task.place_mark = mark.point
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
@@ -780,13 +781,25 @@ class Session:
         T = invert(planar_pose(*self.robot.base_pose()))
         return T[:3, :3] @ v if direction else T[:3, :3] @ v + T[:3, 3]
 
+    @property
+    def latest_cloud(self) -> tuple[FusedCloud, np.ndarray] | None:
+        """The last fused cloud (in `base` at capture) and the scooter's (x, y, yaw) pose then,
+        without capturing; None before the first capture. For drawing it in `world`."""
+        return self._cloud_at
+
+    @property
+    def projection(self) -> np.ndarray | None:
+        """The projector image now lit (height x width uint8), or None when nothing is lit."""
+        return self._projection
+
     def cloud(self) -> FusedCloud:
         """The latest fused cloud in `base`; captured afresh when the scooter moved since."""
         pose = self.robot.base_pose()
-        cloud, at = self._cloud, self._cloud_pose
-        if cloud is None or at is None or np.max(np.abs(at - pose)) > 1e-3:
-            cloud = fuse(self.robot.capture(), self.settings.perception)
-            self._cloud, self._cloud_pose = cloud, pose
+        latest = self._cloud_at
+        if latest is not None and np.max(np.abs(latest[1] - pose)) <= 1e-3:
+            return latest[0]
+        cloud = fuse(self.robot.capture(), self.settings.perception)
+        self._cloud_at = (cloud, pose)
         return cloud
 
     def cloud_bytes(self, voxel: float | None = None) -> bytes:
