@@ -4,7 +4,7 @@ VENV := .venv/bin
 export MUJOCO_GL ?= egl
 export PYOPENGL_PLATFORM ?= egl
 
-.PHONY: bootstrap run test test-slow lint bench-rtf
+.PHONY: bootstrap run test test-slow lint bench-rtf bench-api
 
 bootstrap:
 	@scripts/bootstrap.sh
@@ -23,3 +23,6 @@ lint: bootstrap
 
 bench-rtf: bootstrap  ## real-time factor with the console and cameras (30 s)
 	$(VENV)/python bench/realtime_factor.py
+
+bench-api: bootstrap  ## the API under load: 20 watchers and a 50 commands/s controller (60 s)
+	$(VENV)/python bench/api_load.py

@@ -244,9 +244,10 @@ def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) ->
         time.sleep(1.5)
     finally:
         watcher.close()
-    still = [wall - dropped for wall, _, qd in watcher.frames if wall > dropped and qd > 0.01]
-    assert still, "no frames were seen after the drop"
-    assert max(still) < 0.5, f"the arm kept moving {max(still):.2f} s after the drop"
+    after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
+    assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
+    moving = [dt for dt, qd in after if qd > 0.01]
+    assert not moving or max(moving) < 0.5, f"the arm kept moving {max(moving):.2f} s after"
     state = http.get(f"{server.url}{API}/state").json()
     assert state["job"] in (None, "picking")  # halted, and retreating or done
 

@@ -52,6 +52,7 @@ _ROOT = "/laserpick/console"
 CLOUD_VOXEL = 0.008
 CLOUD_POINT_SIZE = 0.005
 LIT_POINT_SIZE = 0.012
+LIT_VOXEL = 0.005
 DARK = np.array([70, 74, 82], np.uint8)  #: unlit cloud points
 LIT = np.array([255, 236, 120], np.uint8)  #: points the projector lights
 LASER_RED = (235, 20, 20)
@@ -102,18 +103,10 @@ class _Drawn:
     """What was last drawn, to redraw only what changed."""
 
     cloud_key: tuple[int, int] | None = None
+    lit_key: tuple[int, int] | None = None
     grasp_key: tuple[int, int, int] | None = None
     place_key: tuple[float, ...] | None = None
     nodes: dict[str, viser.SceneNodeHandle] = field(default_factory=dict)
-
-
-@dataclass
-class LatencyLog:
-    """Click-to-highlight latencies (s): from the confirming click's arrival to the lit cloud
-    being sent to the browser."""
-
-    clicked_at: float | None = None
-    samples: list[float] = field(default_factory=list)
 
 
 class OperatorConsole:
@@ -125,7 +118,6 @@ class OperatorConsole:
 
     def __init__(self, session: Session, server: viser.ViserServer, *, controls: bool = True):
         self.session, self.server, self.controls = session, server, controls
-        self.latency = LatencyLog()
         self._drawn = _Drawn()
         self._lock = threading.RLock()
         self._stop = threading.Event()
@@ -216,7 +208,6 @@ class OperatorConsole:
             return
         if before is not None and np.linalg.norm(hit[0] - before) < CONFIRM_RADIUS:
             self._aimed_at = None
-            self.latency.clicked_at = time.perf_counter()
             self.act(event.client, session.confirm)
         else:
             self._aimed_at = hit[0]
@@ -339,53 +330,56 @@ class OperatorConsole:
             old.remove()
 
     def _draw_cloud(self) -> None:
+        """The lit points first (the highlight is what the user waits for), then the dark
+        cloud under them, each only when it changed."""
         latest = self.session.latest_cloud
         image = self.session.projection
-        key = None if latest is None else (id(latest[0]), id(image))
-        if key == self._drawn.cloud_key:
-            return
-        self._drawn.cloud_key = key
+        lit_key = None if latest is None else (id(latest[0]), id(image))
+        cloud_key = None if latest is None else (id(latest[0]), 0)
         if latest is None:
             self._node("cloud", None)
             self._node("lit", None)
+            self._drawn.cloud_key = self._drawn.lit_key = None
             return
         cloud, pose = latest
-        points = cloud.points[voxel_first(cloud.points, CLOUD_VOXEL)].astype(np.float64)
-        lit = (
-            lit_by(self.session.projector, image, points)
-            if image is not None
-            else np.zeros(len(points), bool)
-        )
-        scene = self.server.scene
-        self._node(
-            "cloud",
-            scene.add_point_cloud(
-                f"{_ROOT}/cloud",
-                points=to_world(points[~lit], pose).astype(np.float32),
-                colors=DARK,
-                point_size=CLOUD_POINT_SIZE,
-                point_shape="rounded",
-                visible=self._show_cloud,
-            ),
-        )
-        # The lit points always show, larger and bright, as the projector's light on the
-        # object does whether or not the cloud is drawn.
-        self._node(
-            "lit",
-            scene.add_point_cloud(
-                f"{_ROOT}/lit",
-                points=to_world(points[lit], pose).astype(np.float32),
-                colors=LIT,
-                point_size=LIT_POINT_SIZE,
-                point_shape="circle",
-                point_shading="flat",
+        if lit_key != self._drawn.lit_key:
+            self._drawn.lit_key = lit_key
+            lit = (
+                cloud.points[lit_by(self.session.projector, image, cloud.points)]
+                if image is not None
+                else cloud.points[:0]
             )
-            if lit.any()
-            else None,
-        )
-        if image is not None and self.latency.clicked_at is not None:
-            self.latency.samples.append(time.perf_counter() - self.latency.clicked_at)
-            self.latency.clicked_at = None
+            # Larger and bright, and drawn whether or not the cloud is: the projector's light
+            # on the object shows either way.
+            self._node(
+                "lit",
+                self.server.scene.add_point_cloud(
+                    f"{_ROOT}/lit",
+                    points=to_world(lit[voxel_first(lit, LIT_VOXEL)], pose).astype(np.float32),
+                    colors=LIT,
+                    point_size=LIT_POINT_SIZE,
+                    point_shape="circle",
+                    point_shading="flat",
+                )
+                if len(lit)
+                else None,
+            )
+            if len(lit):
+                self.session.announce("highlight", points=len(lit))
+        if cloud_key != self._drawn.cloud_key:
+            self._drawn.cloud_key = cloud_key
+            points = cloud.points[voxel_first(cloud.points, CLOUD_VOXEL)]
+            self._node(
+                "cloud",
+                self.server.scene.add_point_cloud(
+                    f"{_ROOT}/cloud",
+                    points=to_world(points, pose).astype(np.float32),
+                    colors=DARK,
+                    point_size=CLOUD_POINT_SIZE,
+                    point_shape="rounded",
+                    visible=self._show_cloud,
+                ),
+            )
 
     def _draw_laser(self) -> None:
         robot = self.session.robot

@@ -76,10 +76,6 @@ class AimRequest(_Body):
         kinds = (angles == 2) + (self.point is not None) + (self.ray is not None)
         if kinds != 1:
             raise ValueError("give exactly one of: yaw and pitch, point, ray")
-        if self.point is not None and math.hypot(*self.point[:2]) > _server.max_reach + 50 * (
-            self.frame == "world"
-        ):
-            raise ValueError(f"point is farther than {_server.max_reach} m from the scooter")
         return self
 
 

@@ -68,6 +68,10 @@ StrategyName = Literal["gpd", "overhead", "jeeves"]
 Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
 
 
+#: The watchdog's period (s), and the gap between its ticks that means the process stalled.
+WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
+
+
 class TaskState(StrEnum):
     IDLE = "idle"
     AIMING = "aiming"
@@ -223,6 +227,11 @@ class Session:
         """Call `fn(robot)` after a scene reset replaced the robot (the 3D view rebuilds)."""
         self._scene_listeners.append(fn)
 
+    def announce(self, name: str, /, **fields: Any) -> None:
+        """Send a discrete event to every listener (the events websocket among them): for
+        in-process clients, e.g. the 3D view saying the highlight is on screen."""
+        self._emit(name, **fields)
+
     def _emit(self, name: str, /, **fields: Any) -> None:
         event = {"type": "event", "name": name, "t": time.time(), "state": self.state.value}
         event.update(fields)
@@ -349,6 +358,12 @@ class Session:
     def aim_at(self, actor: Actor, point: np.ndarray, frame: Literal["base", "world"]) -> None:
         """Point the laser at a point (m) in `base` or `world`."""
         p = self._to_base(np.asarray(point, dtype=float), frame)
+        reach = self.settings.server.max_reach
+        if np.linalg.norm(p[:2]) > reach:
+            raise ValueError(
+                f"point is {np.linalg.norm(p[:2]):.1f} m from the scooter; the laser is aimed"
+                f" within {reach:.0f} m"
+            )
         with self._lock:
             self._require(actor, "laser/aim", AIMABLE)
             self.robot.laser.aim_at(p)
@@ -513,10 +528,18 @@ class Session:
                 self._set(TaskState.AIMING if aiming else TaskState.IDLE, "Driving.")
             self._cloud_at = None
 
+    def _await_estop(self, latched: bool, timeout: float = 0.5) -> None:
+        """Wait (briefly) until the simulation has applied an e-stop or its reset, so that the
+        next command sees it: commands reach the simulation thread at its next step."""
+        end = time.monotonic() + timeout
+        while self.estopped != latched and time.monotonic() < end:
+            time.sleep(0.001)
+
     def stop(self, actor: Actor) -> None:
         """E-stop: arm and base halt within one control tick and stay halted until reset."""
         self.robot.stop()
         self._cancel.set()
+        self._await_estop(True)
         with self._lock:
             self._drive_until = 0.0
             self.message = "E-STOP. Motion is halted until the stop is reset."
@@ -528,6 +551,7 @@ class Session:
             if self.busy:
                 raise self._refuse(actor, "stop/reset", "the stopped job is still winding down")
             self.robot.reset_stop()
+            self._await_estop(False)
             self.message = "Stop reset."
             self._emit("estop_reset", message=self.message)
             self._record(actor, "stop/reset", "ok")
@@ -751,7 +775,14 @@ class Session:
         """Halt motion commanded by a lease holder who has gone silent (no heartbeat for
         `watchdog_s`, or its websocket dropped)."""
         limit = self.settings.server.watchdog_s
-        while not self._closing.wait(0.02):
+        last = time.monotonic()
+        while not self._closing.wait(WATCHDOG_TICK):
+            now = time.monotonic()
+            stalled, last = now - last > WATCHDOG_STALL, now
+            if stalled:
+                # This process itself was not running (a loaded machine): heartbeats that
+                # arrived meanwhile are still queued, so silence cannot be judged this tick.
+                continue
             with self._lock:
                 token = self._motion_token if self.busy else None
                 driving = time.monotonic() < self._drive_until and self._drive_token is not None

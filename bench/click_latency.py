@@ -1,0 +1,118 @@
+"""Click-to-highlight latency of the 3D console (issue 6's target: 250 ms or less).
+
+A real `laserpick serve` on `isolation`, its 3D view in headless Chromium. For each object:
+click on it (aim), click again on the same spot (confirm), and time from the confirming
+click's pointerdown in the browser to the 3D view sending the lit cloud to the browser (its
+`highlight` event on the events stream). Both clocks are this machine's wall clock. Not
+counted: the loopback hop back to the browser and the frame that draws it; the script
+prints the browser's frame interval beside the figure for that. Between trials the mark is
+cancelled.
+
+    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2]
+
+It prints each trial and the median, p90 and max. The browser renders WebGL in software
+(SwiftShader), so a frame takes longer here than on a machine with a GPU.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from playwright.sync_api import sync_playwright
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests"))
+
+from serve_process import ServeProcess  # noqa: E402
+
+from laserpick.client import Client  # noqa: E402
+from laserpick.console import headless_chromium  # noqa: E402
+from laserpick.console.viewer import default_view_pixel  # noqa: E402
+
+# The wall-clock time (ms since the epoch) of every pointerdown, and a running measure of the
+# interval between animation frames.
+PROBE = """
+window.__lp = { downs: [], frames: [] };
+document.addEventListener(
+  "pointerdown", (e) => window.__lp.downs.push(performance.timeOrigin + e.timeStamp), true);
+let last = null;
+const tick = (t) => {
+  if (last !== null && window.__lp.frames.length < 2000) window.__lp.frames.push(t - last);
+  last = t;
+  requestAnimationFrame(tick);
+};
+requestAnimationFrame(tick);
+"""
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
+    args = parser.parse_args()
+    samples: list[float] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        server = ServeProcess(Path(tmp), extra_args=("--no-shadows",)).start()
+        # The bench holds the operator station's lease; the 3D view's clicks act under it.
+        api = Client(server.url, name="latency bench", source="console")
+        try:
+            api.take_control()
+            objects = [o for o in api.get("/sim/objects") if not o["in_basket"]]
+            with sync_playwright() as p:
+                browser = headless_chromium.launch(p)
+                page = browser.new_page(viewport={"width": 900, "height": 600})
+                page.add_init_script(PROBE)
+                page.goto(server.viser_url)
+                page.get_by_role("button", name="Detect").wait_for(timeout=30_000)
+                time.sleep(5.0)  # the scene fades in
+                box = page.locator("canvas").first.bounding_box()
+                for _ in range(args.rounds):
+                    for obj in objects:
+                        x, y = default_view_pixel(obj["center_base"], box["width"], box["height"])
+                        x, y = box["x"] + x, box["y"] + y
+                        page.mouse.click(x, y)
+                        api.wait_for(lambda s: s["state"] == "aiming" and not s["busy"], 20)
+                        seen = len(api.events)
+                        page.mouse.click(x, y)
+                        # The click reaches the server on its own path: wait until it has
+                        # taken it (the mark is confirmed), then until the work is done.
+                        api.wait_for(lambda s: s["state"] != "aiming" or s["busy"], 20)
+                        state = api.wait_for(lambda s: not s["busy"], 60)
+                        time.sleep(0.5)
+                        clicked = page.evaluate("window.__lp.downs")[-1] / 1000.0
+                        shown = [
+                            e["t"]
+                            for e in api.events[seen:]
+                            if e["name"] == "highlight" and e["t"] > clicked
+                        ]
+                        if shown:
+                            samples.append(1000.0 * (shown[0] - clicked))
+                            print(f"{obj['name']:>18}: {samples[-1]:6.0f} ms  ({state['state']})")
+                        else:
+                            print(f"{obj['name']:>18}: no highlight ({state['message']})")
+                        api.post("/cancel")
+                frames = page.evaluate("window.__lp.frames")
+                browser.close()
+        finally:
+            api.release()
+            server.close()
+    if not samples:
+        print("no highlight was seen")
+        return 1
+    ordered = np.sort(samples)
+    print(
+        f"\nclick-to-highlight over {len(samples)} marks: median {statistics.median(samples):.0f}"
+        f" ms, p90 {np.percentile(ordered, 90):.0f} ms, max {ordered[-1]:.0f} ms (target 250);"
+        f" the browser's frame interval: median {statistics.median(frames):.0f} ms"
+        " (software WebGL)"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
