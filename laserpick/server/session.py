@@ -30,7 +30,6 @@ Frames: points in `base` (m) unless a method says `world`; angles in radians.
 
 from __future__ import annotations
 
-import io
 import logging
 import threading
 import time
@@ -44,7 +43,7 @@ import numpy as np
 
 from laserpick.behaviours import GRIPPER_TIME, Behaviours
 from laserpick.description import dims
-from laserpick.pipeline.cloud import fuse, ray_hit, voxel_downsample
+from laserpick.pipeline.cloud import fuse, ray_hit
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
@@ -833,24 +832,6 @@ class Session:
         self._cloud_at = (cloud, pose)
         return cloud
 
-    def cloud_bytes(self, voxel: float | None = None) -> bytes:
-        """The cloud in the compact binary form of GET /cloud (see `CLOUD_FORMAT`)."""
-        cloud = voxel_downsample(self.cloud(), voxel or self.settings.server.cloud_voxel)
-        n = len(cloud)
-        header = np.array([n], dtype="<u4").tobytes()
-        return CLOUD_MAGIC + header + cloud.points.astype("<f4").tobytes()
-
-    def projection_png(self) -> bytes:
-        """The projector image as PNG: the target (or the place spot) white, the rest black."""
-        from PIL import Image
-
-        img = self._projection
-        if img is None:
-            img = np.zeros((self.projector.height, self.projector.width), np.uint8)
-        buf = io.BytesIO()
-        Image.fromarray(img, mode="L").save(buf, format="PNG", optimize=False, compress_level=1)
-        return buf.getvalue()
-
     def status(self) -> dict[str, Any]:
         """Everything a console shows, as JSON-ready values. Cheap: read at 30 Hz."""
         snap = self.robot.sim.snapshot()
@@ -909,19 +890,3 @@ class Session:
                 "lease": {"held": lease.held, "holder": lease.holder, "source": lease.source},
             }
         return out
-
-
-#: GET /cloud: b"LPC1", then the point count N as uint32, then N x 3 float32 (x, y, z) in
-#: `base` (m), all little-endian.
-CLOUD_MAGIC = b"LPC1"
-CLOUD_FORMAT = "LPC1 | uint32 N | N x (float32 x, y, z) in base, metres, little-endian"
-
-
-def decode_cloud(data: bytes) -> np.ndarray:
-    """The (N, 3) float32 points of a GET /cloud body; ValueError if it is not one."""
-    if data[:4] != CLOUD_MAGIC or len(data) < 8:
-        raise ValueError("not a laserpick cloud (bad magic)")
-    n = int(np.frombuffer(data[4:8], dtype="<u4")[0])
-    if len(data) != 8 + 12 * n:
-        raise ValueError(f"a cloud of {n} points needs {8 + 12 * n} bytes, got {len(data)}")
-    return np.frombuffer(data[8:], dtype="<f4").reshape(n, 3)
