@@ -67,6 +67,7 @@ StrategyName = Literal["gpd", "overhead", "jeeves"]
 Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
 
 
+ESTOP_REASON = "Stopped by the e-stop; the arm stays where it is."
 #: The watchdog's period (s), and the gap between its ticks that means the process stalled.
 WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
 
@@ -174,6 +175,7 @@ class Session:
         self._job: Future[None] | None = None
         self._job_name = ""
         self._cancel = threading.Event()
+        self._cancel_reason = "Cancelled by the operator."  #: why `_cancel` was set
         self._motion_token: str | None = None  #: whose heartbeat the running motion needs
         self._drive_token: str | None = None
         self._drive_until = 0.0
@@ -498,6 +500,7 @@ class Session:
         Without a job, drop the found target (or the place mark) and rest."""
         with self._lock:
             if self.busy:
+                self._cancel_reason = "Cancelled by the operator."
                 self._cancel.set()
                 self.robot.halt()
                 self._progress("Cancelling.")
@@ -537,6 +540,7 @@ class Session:
     def stop(self, actor: Actor) -> None:
         """E-stop: arm and base halt within one control tick and stay halted until reset."""
         self.robot.stop()
+        self._cancel_reason = ESTOP_REASON
         self._cancel.set()
         self._await_estop(True)
         with self._lock:
@@ -735,13 +739,14 @@ class Session:
         """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
         hand is kept (never dropped from height): the arm raises it and the session holds."""
         cancelled = self._cancel.is_set()
-        if cancelled:
-            failure = Failure("execute", "Cancelled by the operator.")
-        self._cancel.clear()  # the retreat itself must be allowed to move
-        if self.estopped:
+        if self.estopped or (cancelled and self._cancel_reason == ESTOP_REASON):
+            failure = Failure("execute", ESTOP_REASON)
             with self._lock:
                 self._fail(failure, self._resting_state())
             return
+        if cancelled:
+            failure = Failure("execute", self._cancel_reason)
+        self._cancel.clear()  # the retreat itself must be allowed to move
         b = self.behaviours
         if b.held is not None and self.robot.gripper_state().holding:
             self._progress("Raising what the hand holds.")
@@ -792,6 +797,9 @@ class Session:
                 self.robot.halt()
                 with self._lock:
                     if what == "motion":
+                        self._cancel_reason = (
+                            "The controller went silent, so the motion was halted."
+                        )
                         self._cancel.set()
                         self._motion_token = None
                     self._drive_until = 0.0
