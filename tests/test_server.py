@@ -257,6 +257,23 @@ def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) ->
     assert "went silent" in state["failure"]["message"]
 
 
+def test_heartbeats_are_acknowledged_and_strangers_refused(server: ServeProcess) -> None:
+    with Client(server.url, name="pinger") as c:
+        ws = connect("ws" + server.url[4:] + f"{API}/events")
+        try:
+            ws.send(json.dumps({"type": "heartbeat", "token": c.token, "sent": 12.5}))
+            ws.send(json.dumps({"type": "heartbeat", "token": "forged"}))
+            replies = []
+            while len(replies) < 2:
+                msg = json.loads(ws.recv(timeout=5))
+                if msg["type"] in ("heartbeat_ack", "error"):
+                    replies.append(msg)
+        finally:
+            ws.close()
+    assert replies[0]["type"] == "heartbeat_ack" and replies[0]["echo"] == 12.5
+    assert replies[1]["type"] == "error" and "lease" in replies[1]["detail"]
+
+
 def test_a_second_client_cannot_take_control(server: ServeProcess) -> None:
     with Client(server.url, name="first") as first:
         r = requests.post(f"{server.url}{API}/control", json={"name": "second"}, timeout=10)

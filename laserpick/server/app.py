@@ -551,9 +551,7 @@ def create_app(
         try:
             while True:
                 text = await ws.receive_text()
-                reply = _on_message(session, client, text)
-                if reply is not None:
-                    hub.offer(client, json.dumps(reply))
+                hub.offer(client, json.dumps(_on_message(session, client, text)))
         except (WebSocketDisconnect, RuntimeError):
             pass
         finally:
@@ -572,8 +570,8 @@ async def _pump(ws: WebSocket, client: _Client) -> None:
             await ws.send_text(text)
 
 
-def _on_message(session: Session, client: _Client, text: str) -> dict[str, Any] | None:
-    """Handle one client message; the reply to queue, if any."""
+def _on_message(session: Session, client: _Client, text: str) -> dict[str, Any]:
+    """Handle one client message: a heartbeat is acknowledged, anything else refused."""
     try:
         msg = json.loads(text)
     except ValueError:
@@ -584,7 +582,8 @@ def _on_message(session: Session, client: _Client, text: str) -> dict[str, Any] 
     if not isinstance(token, str) or not session.lease.heartbeat(token):
         return {"type": "error", "detail": "heartbeat without a token that holds the lease"}
     client.token = token
-    return None
+    # The client's own `sent` value comes back, so it can time the round trip on its clock.
+    return {"type": "heartbeat_ack", "echo": msg.get("sent"), "t": time.time()}
 
 
 def _round(v: np.ndarray) -> list[float]:
