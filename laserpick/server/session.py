@@ -70,6 +70,8 @@ Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
 ESTOP_REASON = "Stopped by the e-stop; the arm stays where it is."
 #: The watchdog's period (s), and the gap between its ticks that means the process stalled.
 WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
+#: Longest the API's event loop may lag (s) before the watchdog judges silence regardless.
+IO_STALL_MAX = 2.0
 
 
 class TaskState(StrEnum):
@@ -176,6 +178,7 @@ class Session:
         self._job_name = ""
         self._cancel = threading.Event()
         self._cancel_reason = "Cancelled by the operator."  #: why `_cancel` was set
+        self._io_alive: float | None = None  #: monotonic time of the API loop's last tick
         self._motion_token: str | None = None  #: whose heartbeat the running motion needs
         self._drive_token: str | None = None
         self._drive_until = 0.0
@@ -787,6 +790,11 @@ class Session:
                 # This process itself was not running (a loaded machine): heartbeats that
                 # arrived meanwhile are still queued, so silence cannot be judged this tick.
                 continue
+            io_late = now - self._io_alive if self._io_alive is not None else 0.0
+            if WATCHDOG_STALL < io_late < IO_STALL_MAX:
+                # The thread that reads the sockets is behind (starved of CPU): heartbeats
+                # may be waiting unread. A loop stuck for longer halts the motion all the same.
+                continue
             with self._lock:
                 token = self._motion_token if self.busy else None
                 driving = time.monotonic() < self._drive_until and self._drive_token is not None
@@ -806,6 +814,11 @@ class Session:
                     self.message = "The controller went silent: motion halted."
                     self._emit("watchdog", message=self.message)
                     self._record(SYSTEM, "watchdog", "halted", message=self.message)
+
+    def io_alive(self) -> None:
+        """Called by the API's event loop on each of its ticks: it is reading the sockets, so
+        a missing heartbeat is the client's silence, not the server's."""
+        self._io_alive = time.monotonic()
 
     # --- reads ------------------------------------------------------------------------------
 
