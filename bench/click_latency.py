@@ -56,6 +56,7 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
     args = parser.parse_args()
     samples: list[float] = []
+    server_share: list[float] = []  #: from the click's arrival in the server (ms)
     with tempfile.TemporaryDirectory() as tmp:
         server = ServeProcess(Path(tmp), extra_args=("--no-shadows",)).start()
         # The bench holds the operator station's lease; the 3D view's clicks act under it.
@@ -86,13 +87,18 @@ def main() -> int:
                         time.sleep(0.5)
                         clicked = page.evaluate("window.__lp.downs")[-1] / 1000.0
                         shown = [
-                            e["t"]
+                            e
                             for e in api.events[seen:]
                             if e["name"] == "highlight" and e["t"] > clicked
                         ]
                         if shown:
-                            samples.append(1000.0 * (shown[0] - clicked))
-                            print(f"{obj['name']:>18}: {samples[-1]:6.0f} ms  ({state['state']})")
+                            samples.append(1000.0 * (shown[0]["t"] - clicked))
+                            share = 1000.0 * (shown[0].get("since_click") or float("nan"))
+                            server_share.append(share)
+                            print(
+                                f"{obj['name']:>18}: {samples[-1]:6.0f} ms, of which the server"
+                                f" {share:4.0f} ms  ({state['state']})"
+                            )
                         else:
                             print(f"{obj['name']:>18}: no highlight ({state['message']})")
                         api.post("/cancel")
@@ -108,6 +114,8 @@ def main() -> int:
     print(
         f"\nclick-to-highlight over {len(samples)} marks: median {statistics.median(samples):.0f}"
         f" ms, p90 {np.percentile(ordered, 90):.0f} ms, max {ordered[-1]:.0f} ms (target 250);"
+        f" the server's share (click arrived to lit cloud sent): median"
+        f" {statistics.median(server_share):.0f} ms;"
         f" the browser's frame interval: median {statistics.median(frames):.0f} ms"
         " (software WebGL)"
     )

@@ -124,6 +124,7 @@ class OperatorConsole:
         self._thread: threading.Thread | None = None
         self._token: str | None = None  #: the lease this view took itself, if any
         self._aimed_at: np.ndarray | None = None  #: where the last click aimed (m, base)
+        self._confirmed_at: float | None = None  #: when a click last confirmed a mark
         self._wake = threading.Event()
         self._clients: set[int] = set()
         self._show_cloud = True
@@ -208,6 +209,7 @@ class OperatorConsole:
             return
         if before is not None and np.linalg.norm(hit[0] - before) < CONFIRM_RADIUS:
             self._aimed_at = None
+            self._confirmed_at = time.monotonic()
             self.act(event.client, session.confirm)
         else:
             self._aimed_at = hit[0]
@@ -365,7 +367,13 @@ class OperatorConsole:
                 else None,
             )
             if len(lit):
-                self.session.announce("highlight", points=len(lit))
+                # Since a click here confirmed the mark (s): the server's share of the
+                # click-to-highlight time (bench/click_latency.py).
+                since = None
+                if self._confirmed_at is not None:
+                    since = round(time.monotonic() - self._confirmed_at, 4)
+                    self._confirmed_at = None
+                self.session.announce("highlight", points=len(lit), since_click=since)
         if cloud_key != self._drawn.cloud_key:
             self._drawn.cloud_key = cloud_key
             points = cloud.points[voxel_first(cloud.points, CLOUD_VOXEL)]
