@@ -155,3 +155,10 @@ def test_the_projector_covers_the_reachable_table(scene):
         pts = cloud.points[c.object_points(cloud, p.instance)]
         inside = len(_pixels(proj, pts)) / max(1, len(pts))
         assert inside > 0.95, f"{p.instance}: only {inside:.0%} of its points can be lit"
+
+
+def test_the_robots_projector_calibration_matches_the_model(scene) -> None:
+    c, proj, _seg, _cloud = scene
+    calibrated = c.robot.projector()
+    np.testing.assert_allclose(calibrated.T_base_proj, proj.T_base_proj, atol=1e-6)
+    np.testing.assert_allclose(calibrated.K, proj.K, atol=1e-9)
