@@ -210,7 +210,7 @@ class OperatorConsole:
         if before is not None and np.linalg.norm(hit[0] - before) < CONFIRM_RADIUS:
             self._aimed_at = None
             self._confirmed_at = time.monotonic()
-            self.act(event.client, session.confirm)
+            self.act(event.client, lambda a: session.confirm(a, point=hit[0]))
         else:
             self._aimed_at = hit[0]
 

@@ -49,7 +49,7 @@ from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.selection import GraspCursor
-from laserpick.pipeline.types import Failure, FusedCloud, Grasp
+from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
 from laserpick.robot.scenes import Scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.server.journal import Journal
@@ -72,6 +72,8 @@ ESTOP_REASON = "Stopped by the e-stop; the arm stays where it is."
 WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
 #: Longest the API's event loop may lag (s) before the watchdog judges silence regardless.
 IO_STALL_MAX = 2.0
+#: A capture older than this (s) is not reused for aiming or a clicked mark.
+CAPTURE_MAX_AGE = 5.0
 
 
 class TaskState(StrEnum):
@@ -130,6 +132,18 @@ class _Task:
     cursor: GraspCursor | None = None
     place_mark: np.ndarray | None = None
     timings: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Capture:
+    """One capture: the frames, their fused cloud (in `base`), the scooter's (x, y, yaw) pose
+    and the monotonic time (s) when it was taken. Replaced whole, so readers on other threads
+    never see a cloud with another capture's pose."""
+
+    frames: tuple[DepthFrame, ...]
+    cloud: FusedCloud
+    pose: np.ndarray
+    at: float
 
 
 def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
@@ -208,9 +222,7 @@ class Session:
         self.failure: Failure | None = None
         self.message = "Ready. Aim the laser at an object."
         self._projection: np.ndarray | None = None
-        #: the last fused cloud and the scooter's pose when it was captured (one reference,
-        #: so readers on other threads never see a cloud with another capture's pose)
-        self._cloud_at: tuple[FusedCloud, np.ndarray] | None = None
+        self._capture: _Capture | None = None
 
     def close(self) -> None:
         """Halt, stop the worker and the watchdog, and close the robot."""
@@ -408,9 +420,12 @@ class Session:
                 self._set(TaskState.IDLE, "Laser off.")
             self._record(actor, "laser/off", "ok")
 
-    def confirm(self, actor: Actor) -> None:
+    def confirm(self, actor: Actor, point: np.ndarray | None = None) -> None:
         """Light both beams: mark the object (then perceive and find grasps), or, holding an
-        object in pick-and-place, mark where it goes (then place it)."""
+        object in pick-and-place, mark where it goes (then place it).
+
+        point: where a confirming click landed (m, `base`). The mark is then that point, as
+        from a touch screen, and not the dots found in a new capture."""
         with self._lock:
             self._require(actor, "laser/confirm", (TaskState.AIMING, TaskState.AWAITING_PLACE))
             if not self.robot.laser.state.on:
@@ -424,9 +439,8 @@ class Session:
                 if self.strategy == "jeeves":
                     self._require_motion(actor, "laser/confirm")
                 self._set(TaskState.MARKED, "Marked. Looking at the object.")
-                self._start(
-                    actor, "perceiving", self._perceive_job, motion=self.strategy == "jeeves"
-                )
+                job = self._perceive_job if point is None else lambda: self._perceive_job(point)
+                self._start(actor, "perceiving", job, motion=self.strategy == "jeeves")
 
     def detect(self, actor: Actor) -> None:
         """Find grasps again for the perceived target (e.g. after changing the strategy)."""
@@ -531,7 +545,7 @@ class Session:
                 self._projection = None
                 aiming = self.robot.laser.state.on
                 self._set(TaskState.AIMING if aiming else TaskState.IDLE, "Driving.")
-            self._cloud_at = None
+            self._capture = None
 
     def _await_estop(self, latched: bool, timeout: float = 0.5) -> None:
         """Wait (briefly) until the simulation has applied an e-stop or its reset, so that the
@@ -611,10 +625,13 @@ class Session:
 
     # --- the jobs (worker thread) -----------------------------------------------------------
 
-    def _perceive_job(self) -> None:
-        frames = self.robot.capture()
-        perception = perceive(frames, settings=self.settings.perception)
-        self._cloud_at = (perception.cloud, self.robot.base_pose())
+    def _perceive_job(self, point: np.ndarray | None = None) -> None:
+        """Capture, find the mark in the IR images, segment. With `point` (a confirming click,
+        m in `base`), the mark is that point, and a capture still fresh from aiming is used."""
+        fresh = self._fresh_capture() if point is not None else None
+        frames = list(fresh.frames) if fresh is not None else self.robot.capture()
+        perception = perceive(frames, point=point, settings=self.settings.perception)
+        self._remember(frames, perception.cloud)
         lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
         with self._lock:
             self.task.timings = dict(perception.timings)
@@ -648,7 +665,6 @@ class Session:
                     self._fail(failure, TaskState.PERCEIVED)
                 return
             perception = approached
-            self._cloud_at = (perception.cloud, self.robot.base_pose())
         found = find_grasps(
             perception,
             dims.UR5_READY_Q,
@@ -716,7 +732,7 @@ class Session:
                 self._fail(mark, TaskState.AWAITING_PLACE)
             return
         cloud = fuse(frames, self.settings.perception)
-        self._cloud_at = (cloud, self.robot.base_pose())
+        self._remember(frames, cloud)
         self.task.place_mark = mark.point
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
@@ -836,21 +852,35 @@ class Session:
     def latest_cloud(self) -> tuple[FusedCloud, np.ndarray] | None:
         """The last fused cloud (in `base` at capture) and the scooter's (x, y, yaw) pose then,
         without capturing; None before the first capture. For drawing it in `world`."""
-        return self._cloud_at
+        capture = self._capture
+        return None if capture is None else (capture.cloud, capture.pose)
 
     @property
     def projection(self) -> np.ndarray | None:
         """The projector image now lit (height x width uint8), or None when nothing is lit."""
         return self._projection
 
+    def _remember(self, frames: Sequence[DepthFrame], cloud: FusedCloud) -> None:
+        self._capture = _Capture(tuple(frames), cloud, self.robot.base_pose(), time.monotonic())
+
+    def _fresh_capture(self) -> _Capture | None:
+        """The last capture, if the scooter has not moved since and it is under
+        CAPTURE_MAX_AGE old (people move things)."""
+        capture = self._capture
+        if capture is None or time.monotonic() - capture.at > CAPTURE_MAX_AGE:
+            return None
+        if np.max(np.abs(capture.pose - self.robot.base_pose())) > 1e-3:
+            return None
+        return capture
+
     def cloud(self) -> FusedCloud:
-        """The latest fused cloud in `base`; captured afresh when the scooter moved since."""
-        pose = self.robot.base_pose()
-        latest = self._cloud_at
-        if latest is not None and np.max(np.abs(latest[1] - pose)) <= 1e-3:
-            return latest[0]
-        cloud = fuse(self.robot.capture(), self.settings.perception)
-        self._cloud_at = (cloud, pose)
+        """A fused cloud in `base` under CAPTURE_MAX_AGE old: the last, or a new capture."""
+        fresh = self._fresh_capture()
+        if fresh is not None:
+            return fresh.cloud
+        frames = self.robot.capture()
+        cloud = fuse(frames, self.settings.perception)
+        self._remember(frames, cloud)
         return cloud
 
     def status(self) -> dict[str, Any]:
