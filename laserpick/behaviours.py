@@ -52,6 +52,8 @@ DROP_HEIGHTS = (0.06, 0.10, 0.14)
 RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
+#: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
+PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
 MOTION_SLACK = 3.0
 
@@ -382,23 +384,10 @@ class Behaviours:
         q_now = self._q()
         obstacles = cloud.points[self._not_carried(cloud.points, q_now, held)]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
-        T_place = held.grasp.pose.copy()
-        T_place[:3, 3] = [
-            spot[0],
-            spot[1],
-            spot[2] + held.height_above_support + s.place_clearance,
-        ]
-        T_above = T_place.copy()
-        T_above[2, 3] += s.approach_distance
-        solutions = ik_tcp(T_above, q_now)
-        q_above = next(
-            (q for q in solutions if checker.clearance_ok(q, payload=held.points_tcp)[0]), None
-        )
-        if q_above is None:
-            return Outcome(Failure("ik_plan", "The arm cannot reach above that spot."))
-        down = cartesian_line(q_above, T_place, s.cartesian_step)
-        if down is None:
-            return Outcome(Failure("ik_plan", "The arm cannot lower the object there."))
+        found = self._place_poses(held, spot, q_now, checker)
+        if isinstance(found, Failure):
+            return Outcome(found)
+        q_above, down, T_above = found
         self.progress("Carrying the object to the place mark.")
         out = self.go_to(q_above, checker, "carrying to the place", payload=held.points_tcp)
         if not out.ok:
@@ -417,6 +406,39 @@ class Behaviours:
             self._run(timed(up, s, tcp_speed=s.approach_speed), "rising from the object")
         self.progress("Placed.")
         return Outcome(None, held.grasp, spot=spot)
+
+    def _place_poses(
+        self, held: Held, spot: np.ndarray, q_now: np.ndarray, checker: CollisionChecker
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | Failure:
+        """Where to set the object down at `spot` (m, `base`): the joint angles above it, the
+        straight path down, and the pose above. The grasp's orientation is kept, so that the
+        object stands as it stood, turned about the vertical if the arm cannot reach it
+        unturned (PLACE_YAWS): a turned object still stands upright."""
+        s = self.settings.motion
+        reached = False
+        for dyaw in PLACE_YAWS:
+            T_place = held.grasp.pose.copy()
+            T_place[:3, :3] = rotz(dyaw) @ T_place[:3, :3]
+            T_place[:3, 3] = [
+                spot[0],
+                spot[1],
+                spot[2] + held.height_above_support + s.place_clearance,
+            ]
+            T_above = T_place.copy()
+            T_above[2, 3] += s.approach_distance
+            clear = [
+                q
+                for q in ik_tcp(T_above, q_now)
+                if checker.clearance_ok(q, payload=held.points_tcp)[0]
+            ]
+            reached = reached or bool(clear)
+            for q_above in clear:
+                down = cartesian_line(q_above, T_place, s.cartesian_step)
+                if down is not None:
+                    return q_above, down, T_above
+        if not reached:
+            return Failure("ik_plan", "The arm cannot reach above that spot.")
+        return Failure("ik_plan", "The arm cannot lower the object there.")
 
     @staticmethod
     def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:
