@@ -8,7 +8,11 @@ counted: the loopback hop back to the browser and the frame that draws it; the s
 prints the browser's frame interval beside the figure for that. Between trials the mark is
 cancelled.
 
-    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2]
+    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--no-browser]
+
+`--no-browser` measures the server alone, in this process: the session, the 3D view's drawing
+and its viser server without a browser, from a click-confirmed mark (`Session.confirm` with
+the object's centre as the point) to the lit cloud sent.
 
 It prints each trial and the median, p90 and max. The browser renders WebGL in software
 (SwiftShader), so a frame takes longer here than on a machine with a GPU.
@@ -54,7 +58,10 @@ requestAnimationFrame(tick);
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
+    parser.add_argument("--no-browser", action="store_true", help="the server's share alone")
     args = parser.parse_args()
+    if args.no_browser:
+        return server_only(args.rounds)
     samples: list[float] = []
     server_share: list[float] = []  #: from the click's arrival in the server (ms)
     with tempfile.TemporaryDirectory() as tmp:
@@ -118,6 +125,61 @@ def main() -> int:
         f" {statistics.median(server_share):.0f} ms;"
         f" the browser's frame interval: median {statistics.median(frames):.0f} ms"
         " (software WebGL)"
+    )
+    return 0
+
+
+def server_only(rounds: int) -> int:
+    """Click-confirmed mark to lit cloud sent, in-process, with no browser on the machine."""
+    import threading
+
+    import viser
+
+    from laserpick.bench.operator import Referee
+    from laserpick.console.operator_console import OperatorConsole
+    from laserpick.robot.scenes import load_scene
+    from laserpick.robot.sim_robot import SimRobot
+    from laserpick.server.session import Actor, Session
+
+    session = Session(SimRobot(load_scene("isolation"), realtime=True))
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    console = OperatorConsole(session, server)
+    console.start()
+    shown = threading.Event()
+    session.on_event(lambda e: shown.set() if e["name"] == "highlight" else None)
+    actor = Actor("console", session.lease.acquire("latency bench", "console"))
+    referee = Referee(session.robot)
+    samples: list[float] = []
+    try:
+        time.sleep(2.0)
+        for _ in range(rounds):
+            for name in referee.instances():
+                pts = referee.object_points(name)
+                centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+                session.aim_at(actor, centre, "base")
+                session.cloud()  # the capture a first click makes while aiming
+                time.sleep(0.5)
+                shown.clear()
+                t0 = time.monotonic()
+                session.confirm(actor, point=centre)
+                if shown.wait(5.0):
+                    samples.append(1000.0 * (time.monotonic() - t0))
+                    print(f"{name:>18}: {samples[-1]:6.0f} ms")
+                else:
+                    print(f"{name:>18}: no highlight ({session.message})")
+                while session.busy:
+                    time.sleep(0.1)
+                session.cancel(actor)
+    finally:
+        console.stop()
+        session.close()
+        server.stop()
+    if not samples:
+        return 1
+    print(
+        f"\nconfirm-to-highlight, server alone, over {len(samples)} marks: median"
+        f" {statistics.median(samples):.0f} ms, p90 {np.percentile(samples, 90):.0f} ms,"
+        f" max {max(samples):.0f} ms (target 250)"
     )
     return 0
 
