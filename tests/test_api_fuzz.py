@@ -29,12 +29,6 @@ scene are not sent: each reset takes about 2 s (tests/test_scenes.py covers load
 
 from __future__ import annotations
 
-import os
-import queue
-import subprocess
-import sys
-import threading
-import time
 from collections import Counter, defaultdict
 from collections.abc import Iterator
 from pathlib import Path
@@ -45,6 +39,7 @@ import requests
 import schemathesis
 from schemathesis import AuthContext, Case
 from schemathesis.checks import load_all_checks
+from serve_process import ServeProcess
 
 from laserpick.client import Client
 from laserpick.robot.scenes import builtin_scene_names
@@ -52,7 +47,6 @@ from laserpick.settings import get_settings
 
 REPO = Path(__file__).resolve().parents[1]
 API = "/api/v1"
-READY = "laserpick: console at "
 #: Fuzzed cases per operation (after the examples and coverage phases).
 MAX_EXAMPLES = 50
 #: ... for `POST /scene`.
@@ -61,58 +55,6 @@ BUILTIN_SCENES = frozenset(builtin_scene_names())
 
 #: Status codes seen per operation label, e.g. "POST /api/v1/laser/nudge" (for test 4).
 _statuses: defaultdict[str, Counter[int]] = defaultdict(Counter)
-
-
-class _Server:
-    """`laserpick serve` in a subprocess, its output read by a thread."""
-
-    def __init__(self, journal: Path) -> None:
-        env = dict(os.environ, MUJOCO_GL="egl", PYOPENGL_PLATFORM="egl")
-        env.pop("LASERPICK_OPERATOR_PASSWORD", None)
-        env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"]
-            + ["--port", "0", "--viser-port", "0", "--scene", "isolation"]
-            + ["--journal", str(journal)],
-            cwd=REPO,
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            start_new_session=True,
-        )
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.output: list[str] = []
-        threading.Thread(target=self._read, name="serve-output", daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.output.append(line)
-            self.lines.put(line)
-
-    def wait_for_url(self, timeout: float) -> str:
-        """The API's base URL, once the server printed it."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            try:
-                line = self.lines.get(timeout=0.2)
-            except queue.Empty:
-                if self.proc.poll() is not None:
-                    break
-                continue
-            if line.startswith(READY):
-                return line[len(READY) :].strip().rstrip("/")
-        raise RuntimeError("laserpick serve never became ready:\n" + "".join(self.output))
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(timeout=5)
 
 
 class _Lease:
@@ -154,11 +96,11 @@ _lease: _Lease | None = None  # for the auth provider, which schemathesis instan
 
 @pytest.fixture(scope="module")
 def server_url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    server = _Server(tmp_path_factory.mktemp("fuzz") / "journal.sqlite3")
+    server = ServeProcess(tmp_path_factory.mktemp("fuzz"))
     try:
-        yield server.wait_for_url(timeout=90)
+        yield server.start(timeout=90).url
     finally:
-        server.stop()
+        server.close()
 
 
 @pytest.fixture(scope="module")
