@@ -30,8 +30,6 @@ import argparse
 import json
 import math
 import os
-import queue
-import subprocess
 import sys
 import tempfile
 import threading
@@ -55,62 +53,11 @@ from websockets.sync.client import connect
 from laserpick.client import API, ApiError, Client
 
 REPO = Path(__file__).resolve().parents[1]
-READY = "laserpick: console at "
+sys.path.insert(0, str(REPO / "tests"))
 
+from serve_process import ServeProcess  # noqa: E402
 
 # --- the server ----------------------------------------------------------------------------
-
-
-class Server:
-    """`laserpick serve` in a subprocess on free ports, its output read by a thread."""
-
-    def __init__(self, scene: str, journal: Path) -> None:
-        env = dict(os.environ, MUJOCO_GL="egl", PYOPENGL_PLATFORM="egl")
-        env.pop("LASERPICK_OPERATOR_PASSWORD", None)
-        env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
-        cmd = [sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"]
-        cmd += ["--port", "0", "--viser-port", "0", "--scene", scene, "--journal", str(journal)]
-        self.proc = subprocess.Popen(
-            cmd,
-            cwd=REPO,
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            start_new_session=True,
-        )
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.output: list[str] = []
-        threading.Thread(target=self._read, name="serve-output", daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.output.append(line)
-            self.lines.put(line)
-
-    def wait_for_url(self, timeout: float) -> str | None:
-        """The console's URL once printed; None if the server exited or timed out."""
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            try:
-                line = self.lines.get(timeout=0.2)
-            except queue.Empty:
-                if self.proc.poll() is not None:
-                    return None
-                continue
-            if line.startswith(READY):
-                return line[len(READY) :].strip().rstrip("/")
-        return None
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(timeout=5)
 
 
 # --- the load ------------------------------------------------------------------------------
@@ -341,17 +288,17 @@ def main(argv: list[str] | None = None) -> int:
     if args.url:
         return run(args.url.rstrip("/"), args)
     with tempfile.TemporaryDirectory(prefix="laserpick-api-load-") as tmp:
-        server = Server(args.scene, Path(tmp) / "journal.sqlite3")
+        server = ServeProcess(Path(tmp), scene=args.scene)
         try:
-            url = server.wait_for_url(timeout=120)
-            if url is None:
-                print("api_load: the server did not start:", file=sys.stderr)
-                print("".join(server.output[-30:]), file=sys.stderr)
+            try:
+                server.start(timeout=120)
+            except AssertionError as exc:
+                print(f"api_load: the server did not start:\n{exc}", file=sys.stderr)
                 return 2
             time.sleep(2.0)  # let the simulation settle into real time
-            return run(url, args)
+            return run(server.url, args)
         finally:
-            server.stop()
+            server.close()
 
 
 if __name__ == "__main__":
