@@ -10,7 +10,6 @@
 
 from __future__ import annotations
 
-import base64
 import os
 import signal
 import socket
@@ -21,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from screenshots import pixel_stats
 from serve_process import ServeProcess
 
 from laserpick.client import Client
@@ -50,45 +50,6 @@ def _laserpick(*args: str) -> list[str]:
     return [sys.executable, "-m", "laserpick.cli", *args]
 
 
-# Colour statistics of a PNG, computed in the browser (no image library needed here):
-# the shares of pixels of the scooter's red shell, of the projector's yellow light and of
-# green grasp outlines, and the number of distinct colours (4 bits per channel) that cover at
-# least 0.2 % of the image.
-_PNG_STATS_JS = """
-async (b64) => {
-  const img = new Image();
-  img.src = "data:image/png;base64," + b64;
-  await img.decode();
-  const c = document.createElement("canvas");
-  c.width = img.width; c.height = img.height;
-  const ctx = c.getContext("2d");
-  ctx.drawImage(img, 0, 0);
-  const d = ctx.getImageData(0, 0, c.width, c.height).data;
-  const n = c.width * c.height;
-  const bins = new Map();
-  let red = 0, lit = 0, green = 0;
-  for (let i = 0; i < d.length; i += 4) {
-    const r = d[i], g = d[i + 1], b = d[i + 2];
-    if (r > 120 && r - g > 80 && r - b > 80 && Math.abs(g - b) < 40) red++;
-    if (r > 230 && g > 210 && b > 80 && b < 170) lit++;  // the projector's yellow light
-    if (g > 150 && g - r > 60 && g - b > 80) green++;  // a high-scoring grasp outline
-    const k = ((r >> 4) << 8) | ((g >> 4) << 4) | (b >> 4);
-    bins.set(k, (bins.get(k) || 0) + 1);
-  }
-  let colours = 0;
-  for (const v of bins.values()) if (v >= 0.002 * n) colours++;
-  return {
-    red: red / n, lit: lit / n, green: green / n, colours: colours,
-    width: c.width, height: c.height,
-  };
-}
-"""
-
-
-def _pixel_stats(page, png: bytes) -> dict:
-    return page.evaluate(_PNG_STATS_JS, base64.b64encode(png).decode())
-
-
 def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: Path) -> None:
     """The 3D view of a live server in headless Chromium: it renders; a click on the mug aims
     the laser there and a second click confirms the mark (the state's mark lands on the
@@ -115,7 +76,7 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
                 good, t0 = 0, time.monotonic()
                 while time.monotonic() - t0 < 45 and good < 2:
                     time.sleep(1.0)
-                    stats = _pixel_stats(page, page.screenshot())
+                    stats = pixel_stats(page, page.screenshot())
                     good = good + 1 if stats["colours"] >= 6 else 0
                 assert stats["colours"] >= 6, f"the view looks blank: {stats}"
 
@@ -134,7 +95,7 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
 
                 time.sleep(3.0)  # the lit cloud and the outlines reach the browser
                 png = page.screenshot(path=str(ARTIFACTS / "console.png"))
-                stats = _pixel_stats(page, png)
+                stats = pixel_stats(page, png)
                 assert stats["lit"] > 0.0005, f"no lit target on screen: {stats}"
                 assert stats["green"] > 0.00005, f"no grasp outline on screen: {stats}"
 

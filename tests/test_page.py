@@ -17,7 +17,6 @@
 
 from __future__ import annotations
 
-import base64
 import math
 import time
 from collections.abc import Callable, Iterator
@@ -25,6 +24,7 @@ from pathlib import Path
 
 import pytest
 from basket import judge_drop
+from screenshots import pixel_stats
 from serve_process import ServeProcess
 
 from laserpick.client import ApiError, Client
@@ -214,29 +214,6 @@ def finish_pick(server: ServeProcess, started: float) -> dict:
 
 # --- 1. the page and its 3D view ---------------------------------------------------------
 
-# Distinct colours (4 bits per channel) covering at least 0.2 % of a PNG, counted in the
-# browser (no image library needed here).
-_COLOURS_JS = """
-async (b64) => {
-  const img = new Image();
-  img.src = "data:image/png;base64," + b64;
-  await img.decode();
-  const c = document.createElement("canvas");
-  c.width = img.width; c.height = img.height;
-  const ctx = c.getContext("2d");
-  ctx.drawImage(img, 0, 0);
-  const d = ctx.getImageData(0, 0, c.width, c.height).data;
-  const bins = new Map();
-  for (let i = 0; i < d.length; i += 4) {
-    const k = ((d[i] >> 4) << 8) | ((d[i + 1] >> 4) << 4) | (d[i + 2] >> 4);
-    bins.set(k, (bins.get(k) || 0) + 1);
-  }
-  let n = 0;
-  for (const v of bins.values()) if (v >= 0.002 * c.width * c.height) n++;
-  return n;
-}
-"""
-
 
 def test_page_loads_and_the_3d_view_renders(browser, server: ServeProcess) -> None:
     page = open_page(browser, server, view=True)
@@ -254,7 +231,7 @@ def wait_rendered(page) -> None:
     while time.monotonic() - t0 < 60 and good < 2:
         time.sleep(1.0)
         png = page.locator("iframe#view").screenshot()
-        colours = page.evaluate(_COLOURS_JS, base64.b64encode(png).decode())
+        colours = pixel_stats(page, png)["colours"]
         good = good + 1 if colours >= 6 else 0
     assert colours >= 6, f"the 3D view looks blank ({colours} colours)"
     print(f"3D view rendered after {time.monotonic() - t0:.1f} s")
