@@ -4,7 +4,7 @@ VENV := .venv/bin
 export MUJOCO_GL ?= egl
 export PYOPENGL_PLATFORM ?= egl
 
-.PHONY: bootstrap run test test-slow lint bench-rtf bench-api
+.PHONY: bootstrap run test test-slow lint bench bench-rtf bench-api
 
 bootstrap:
 	@scripts/bootstrap.sh
@@ -26,3 +26,9 @@ bench-rtf: bootstrap  ## real-time factor with the console and cameras (30 s)
 
 bench-api: bootstrap  ## the API under load: 20 watchers and a 50 commands/s controller (60 s)
 	$(VENV)/python bench/api_load.py
+
+bench: bootstrap  ## the papers' headline experiments, reports in bench-results/ (docs/bench.md)
+	@for p in isolation selection in-situ pick-place; do \
+		$(VENV)/laserpick bench --protocol $$p --out bench-results/$$p.json > /dev/null || exit 1; \
+	done
+	@echo "bench: reports in bench-results/*.md"

@@ -2,6 +2,10 @@
 
     laserpick serve [--host 127.0.0.1] [--port 8000] [--viser-port 8080] [--scene isolation]
                     [--journal FILE]
+    laserpick adapter switch|joystick ...
+    laserpick bench --protocol P [--trials N] [--seed S] [--selection auto|manual]
+                    [--strategy gpd|overhead|jeeves] [--scene FILE] [--out FILE.json]
+                    [--workers N] [--ray ADDRESS] [--tremor DEG] [--objects N]
 
 `serve` loads a scene (a built-in name or a YAML path), runs the real-time simulation and the
 operator session, serves the page and the API (uvicorn) and the viser 3D view, and records
@@ -14,7 +18,10 @@ a robot; taking control then needs that password. The viser port has no authenti
 own, so on a non-loopback host the 3D view is view-only (no Pause button) and should sit
 behind the TLS proxy in deploy/.
 
-Exit codes: 0 clean shutdown, 2 bad usage (unknown scene, refused host).
+`bench` reruns one of the papers' experiments with the scripted operator (docs/bench.md).
+
+Exit codes: 0 clean shutdown (or a finished benchmark), 2 bad usage (unknown scene, refused
+host, a bad count).
 """
 
 from __future__ import annotations
@@ -63,7 +70,7 @@ def _url_host(host: str) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser: one subcommand per verb (`serve`, `adapter`; `bench` later)."""
+    """The argument parser: one subcommand per verb (`serve`, `adapter`, `bench`)."""
     parser = argparse.ArgumentParser(
         prog="laserpick",
         description="Assistive laser-directed pick and place: a UR5 on a mobility scooter.",
@@ -181,12 +188,92 @@ def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
     )
     adapter.set_defaults(func=cmd_adapter)
 
+    from laserpick.bench import PROTOCOL_NAMES  # not .protocols: that loads the simulator
+
+    bench = sub.add_parser(
+        "bench",
+        help="rerun a paper's experiment in simulation and report it beside the paper's table",
+        description="Run a benchmark protocol with the scripted operator and write the result"
+        " JSON, a Markdown report and PNG plots (the schema is in docs/bench.md).",
+    )
+    bench.add_argument("--protocol", required=True, choices=PROTOCOL_NAMES, help="which experiment")
+    bench.add_argument("--trials", type=int, help="trials to run (default: the paper's number)")
+    bench.add_argument("--seed", type=int, default=1, help="trial k uses seed SEED + k")
+    bench.add_argument("--selection", choices=["auto", "manual"], help="grasp selection")
+    bench.add_argument("--strategy", choices=["gpd", "overhead", "jeeves"], help="grasp strategy")
+    bench.add_argument("--scene", type=Path, help="a scene YAML file to use instead")
+    bench.add_argument(
+        "--out", type=Path, help="result JSON (default: bench-results/PROTOCOL.json)"
+    )
+    bench.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="local worker processes (default: one per core)",
+    )
+    bench.add_argument("--ray", metavar="ADDRESS", help="run the trials on this Ray cluster")
+    bench.add_argument(
+        "--tremor", type=float, default=0.3, help="aim noise, deg standard deviation (0.3)"
+    )
+    bench.add_argument("--objects", type=int, help="at most this many objects per trial")
+    bench.set_defaults(func=cmd_bench)
+
 
 def cmd_adapter(args: argparse.Namespace) -> int:
     """Run an input adapter until its input ends (a script's end, q, Ctrl-C or SIGTERM)."""
     from laserpick.adapters.launch import run  # lazy: `laserpick --help` stays fast
 
     return run(args)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Run a protocol with a progress bar; write the JSON, the report and the plots."""
+    import json
+
+    from laserpick.bench.protocols import PROTOCOLS, Options
+    from laserpick.bench.report import markdown, write_reports
+    from laserpick.bench.runner import progress_bar, run
+    from laserpick.robot.scenes import SceneError, load_scene
+
+    spec = PROTOCOLS[args.protocol]
+    for name, value in (("--trials", args.trials), ("--workers", args.workers)):
+        if value is not None and value < 1:
+            _say(f"{name} must be at least 1", err=True)
+            return EXIT_USAGE
+    if args.objects is not None and args.objects < 1:
+        _say("--objects must be at least 1", err=True)
+        return EXIT_USAGE
+    if args.scene is not None:
+        try:
+            load_scene(args.scene)
+        except SceneError as exc:
+            _say(str(exc), err=True)
+            return EXIT_USAGE
+    options = Options(
+        selection=args.selection or spec.selection,
+        strategy=args.strategy or spec.strategy,
+        scene=str(args.scene.resolve()) if args.scene else None,
+        tremor_deg=args.tremor,
+        objects=args.objects,
+    )
+    trials = args.trials or spec.trials
+    out = args.out or Path("bench-results") / f"{args.protocol}.json"
+    _say(f"{args.protocol} ({spec.source}): {trials} trials, seed {args.seed}")
+    result = run(
+        args.protocol,
+        trials=trials,
+        seed=args.seed,
+        options=options,
+        workers=min(args.workers, trials),
+        ray_address=args.ray,
+        progress=progress_bar(args.protocol),
+    )
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(result, indent=1))
+    written = [out, *write_reports(result, out)]
+    print(markdown(result))
+    _say("wrote " + ", ".join(str(p) for p in written))
+    return 0
 
 
 def default_journal() -> Path:

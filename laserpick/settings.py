@@ -480,6 +480,12 @@ class MotionSettings(BaseModel):
         2000, ge=10, description="Samples before the joint-space planner gives up."
     )
     rrt_step: float = Field(0.3, gt=0, description="RRT-Connect extension step (rad).")
+    rrt_max_failed: int = Field(
+        6,
+        ge=1,
+        description="Failed joint-space searches in one pick before no more grasps are tried:"
+        " each takes seconds, and a user should not wait minutes for a 'no'. Ours.",
+    )
     drop_height: float = Field(
         0.16, gt=0, description="TCP height (m) above the basket's rim when releasing."
     )

@@ -11,6 +11,7 @@ import pytest
 from laserpick.description import dims
 from laserpick.description.collision import KEEPOUT_BOXES, body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
@@ -206,3 +207,25 @@ def test_plan_pick_refuses_a_grasp_under_the_table():
 def test_checker_ignores_non_finite_points(bad):
     pts = np.array([[1.5, -0.3, bad], [5.0, 5.0, 5.0]])
     assert len(CollisionChecker(pts).points) == 0
+
+
+def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch) -> None:
+    """The leg from the stowed arm to ready is the same for every grasp of a pick: a failed
+    search of it is not repeated per grasp, and failed searches stop the pick at the cap."""
+    calls: list[tuple[float, float]] = []
+
+    def no_path(a, b, *args, **kw):
+        calls.append((float(a[0]), float(b[0])))
+        return None
+
+    monkeypatch.setattr(plan_module, "joint_path", no_path)
+    searches = plan_module.Searches(max_failed=2)
+    home, ready, pre = np.zeros(6), np.full(6, 0.5), np.full(6, 1.0)
+    s = get_settings().motion
+    rng = np.random.default_rng(0)
+    checker = CollisionChecker(np.zeros((0, 3)))
+    for _ in range(3):
+        assert searches.path(home, ready, checker, rng, s) is None
+    assert calls == [(0.0, 0.5)] and not searches.spent
+    assert searches.path(ready, pre, checker, rng, s) is None
+    assert searches.spent and searches.failed == 2

@@ -1,0 +1,40 @@
+"""Benchmarks: the papers' experiments rerun in simulation with a scripted operator.
+
+`laserpick bench --protocol NAME` runs one (see `protocols` and docs/bench.md).
+"""
+
+#: The protocols, in the order the papers' experiments are listed (`protocols.PROTOCOLS` has
+#: the same keys; kept here so that the command line parses without loading the simulator).
+PROTOCOL_NAMES = (
+    "isolation",
+    "in-situ",
+    "pick-place",
+    "selection",
+    "surfaces",
+    "jeeves",
+    "laser-scan",
+)
+#: The failure kinds, in the pipeline's order: 004's (Tables 3 and 5) and "precondition"
+#: (e.g. no object at the mark). Every failed attempt is counted under one.
+FAILURE_KINDS = (
+    "detect_laser",
+    "precondition",
+    "detect_grasp",
+    "ik_plan",
+    "wrong_object",
+    "execute",
+)
+#: The stages timed per attempt (s). All but execute_sim are wall-clock time of the pipeline;
+#: execute_sim is simulated time from "go" until the hand lets go of the object (in the basket
+#: or at the place mark); attempt_total is their sum.
+STAGES = (
+    "acquire_cloud",
+    "detect_laser",
+    "segment",
+    "detect_grasp",
+    "filter",
+    "select",
+    "plan",
+    "execute_sim",
+    "attempt_total",
+)

@@ -1,23 +1,25 @@
-"""The scripted operator and the referee of the grasping experiments (004 section 8).
+"""The referee of the grasping experiments (004 section 8), and how the scripted user drives.
 
-The operator looks at the scene as a person would (the simulator's truth tells it where each
-object is), aims the laser at an object's visible top with hand-tremor noise, and confirms.
-The referee says which object a grasp would close on and whether an object ended up in the
-basket. Neither is ever shown to the pipeline.
+The referee reads the simulator's truth: where each object is, which object a grasp would
+close on, whether an object ended up in the basket, and where a person would aim at one. It
+also does what the experimenter does by hand (empties the basket, moves a stuck arm home).
+None of it is ever shown to the pipeline; the scripted user (`picking.ScriptedOperator`) uses
+it only to look at the world the way a person would.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import mujoco
 import numpy as np
 
 from laserpick.bench.truth import Captured
 from laserpick.description import dims
+from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.types import DepthFrame, Grasp
 from laserpick.robot.scenes import Surface, scene_config
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import invert, planar_pose
@@ -62,6 +64,11 @@ class Referee:
             d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
 
         self.robot.sim.call(move)
+        self.robot.sleep(0.1)  # headless, the call lands at the next step: take it now
+
+    def to_base(self, world: np.ndarray) -> np.ndarray:
+        """A `world` point (m) in `base` now."""
+        return (self._T_base_world() @ np.append(world, 1.0))[:3]
 
     def position(self, instance: str) -> np.ndarray:
         """The object's origin in `base` (m)."""
@@ -100,19 +107,55 @@ class Referee:
         posed = self._posed()
         return {name: self.object_points(name, posed) for name in self.instances()}
 
-    def grasped_object(
-        self, grasp: Grasp, instances: list[str], points: dict[str, np.ndarray] | None = None
+    def object_at(
+        self, position: np.ndarray, points: dict[str, np.ndarray] | None = None
     ) -> str | None:
-        """The object nearest the grasp's TCP (within 4 cm), or None. points: the objects'
-        points as they stood before the grasp (default: as they stand now)."""
+        """The object nearest `position` (m, `base`; a grasp's TCP), within 4 cm, or None.
+        points: the objects' points as they stood before the grasp (default: as they stand
+        now)."""
         points = points if points is not None else self.all_object_points()
         best, best_d = None, 0.04
-        for name in instances:
-            pts = points[name]
-            d = float(np.min(np.linalg.norm(pts - grasp.position, axis=1)))
+        for name, pts in points.items():
+            d = float(np.min(np.linalg.norm(pts - position, axis=1)))
             if d < best_d:
                 best, best_d = name, d
         return best
+
+    def near_hand(self, instance: str, within: float = 0.08) -> bool:
+        """Whether the object's points lie within `within` m of the gripper's TCP."""
+        tcp = tcp_pose(self.robot.joint_state().q)[:3, 3]
+        pts = self.object_points(instance)
+        return bool(np.min(np.linalg.norm(pts - tcp, axis=1)) < within)
+
+    def move_arm_home(self) -> None:
+        """The experimenter moves a stuck arm home by hand (the simulator sets the joints)."""
+        robot = self.robot
+
+        def home(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+            d.qpos[robot.sim.info.arm_qpos] = dims.UR5_HOME_Q
+            d.qvel[robot.sim.info.arm_dof] = 0.0
+
+        robot.sim.call(home)
+        robot.sim.halt()
+        robot.sleep(0.5)
+
+    def free_joint(self, instance: str) -> np.ndarray:
+        """The object's free-joint position (x, y, z, qw, qx, qy, qz) in `world`, to put it
+        back later with `put_back`."""
+        j = self.robot.model.joint(f"obj/{instance}")
+        a = j.qposadr[0]
+        return self.robot.sim.snapshot().qpos[a : a + 7].copy()
+
+    def put_back(self, instance: str, qpos: np.ndarray) -> None:
+        """Set the object down again where `free_joint` found it, at rest."""
+
+        def move(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+            j = m.joint(f"obj/{instance}")
+            d.qpos[j.qposadr[0] : j.qposadr[0] + 7] = qpos
+            d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
+
+        self.robot.sim.call(move)
+        self.robot.sleep(0.3)
 
     def in_basket(self, instance: str) -> bool:
         """Whether the object's origin lies inside the basket: within its walls, above its
@@ -128,23 +171,6 @@ class Referee:
         frames, labels = self.robot.capture_with_labels()
         captured = Captured(self.robot, frames, labels)
         return captured.visible_top(fuse(frames), instance)
-
-
-def aim_with_tremor(robot: SimRobot, point: np.ndarray, rng: np.random.Generator) -> None:
-    """Aim the laser at `point` (`base`, m) with tremor noise on yaw and pitch, and confirm."""
-    st = robot.laser.aim_at(point)
-    robot.laser.aim(st.yaw + rng.normal(0.0, TREMOR_STD), st.pitch + rng.normal(0.0, TREMOR_STD))
-    robot.laser.confirm()
-
-
-def mark_and_capture(
-    robot: SimRobot, point: np.ndarray, rng: np.random.Generator
-) -> list[DepthFrame]:
-    """The operator marks `point`; the robot captures its five frames with the dots in them."""
-    aim_with_tremor(robot, point, rng)
-    frames = robot.capture()
-    robot.laser.off()
-    return frames
 
 
 def scene_config_backed(name: str, back: float) -> dict:
@@ -174,64 +200,65 @@ def parking_pose(surface: Surface, local_y: float = 0.0) -> np.ndarray:
     return np.array([origin[0], origin[1], yaw])
 
 
-def drive_to(robot: SimRobot, goal: np.ndarray, *, reverse_first: float = 0.0) -> bool:
+class Driver(Protocol):
+    """What the scripted user drives with: where the scooter stands (x, y, yaw in `world`),
+    and a drive command (m/s, rad/s) held for 0.1 s of robot time."""
+
+    def base_pose(self) -> np.ndarray: ...
+
+    def drive(self, v: float, w: float) -> None: ...
+
+
+def drive_to(driver: Driver, goal: np.ndarray, *, reverse_first: float = 0.0) -> bool:
     """Drive like a careful user: back out `reverse_first` m, turn toward a point 0.8 m in
-    front of the goal, drive there, turn to face the goal and creep in. Headless. Returns
-    whether the scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`)."""
+    front of the goal, drive there, turn to face the goal and creep in. Returns whether the
+    scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`)."""
     goal = np.asarray(goal, float)
     approach = goal[:2] - 0.8 * np.array([math.cos(goal[2]), math.sin(goal[2])])
     if reverse_first > 0:
-        start = robot.base_pose()[:2].copy()
-        _drive_loop(robot, lambda p: (-0.3, 0.0, np.linalg.norm(p[:2] - start) >= reverse_first))
-    _go_point(robot, approach)
-    _turn_to(robot, goal[2])
-    _go_point(robot, goal[:2], speed=0.2)
-    _turn_to(robot, goal[2])
-    p = robot.base_pose()
+        start = driver.base_pose()[:2].copy()
+        _drive_loop(driver, lambda p: (-0.3, 0.0, np.linalg.norm(p[:2] - start) >= reverse_first))
+    _go_point(driver, approach)
+    _turn_to(driver, goal[2])
+    _go_point(driver, goal[:2], speed=0.2)
+    _turn_to(driver, goal[2])
+    p = driver.base_pose()
     return bool(np.linalg.norm(p[:2] - goal[:2]) < 0.03 and abs(_wrap(p[2] - goal[2])) < 0.035)
-
-
-def creep(robot: SimRobot, distance: float, speed: float = 0.2) -> None:
-    """Drive straight ahead `distance` m at `speed` m/s, as a user pulls up to a table."""
-    start = robot.base_pose()[:2].copy()
-    _drive_loop(
-        robot, lambda p: (speed, 0.0, bool(np.linalg.norm(p[:2] - start) >= distance - 0.005))
-    )
 
 
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
-def _drive_loop(robot: SimRobot, command, timeout: float = 60.0) -> None:
-    """Send drive commands every 0.1 s until command(pose) says done (or `timeout` s)."""
+def _drive_loop(driver: Driver, command, timeout: float = 60.0) -> None:
+    """Drive in 0.1 s steps until command(pose) says done (or `timeout` s of robot time),
+    then let go of the stick for the 1 s ramp down."""
     t = 0.0
     while t < timeout:
-        v, w, done = command(robot.base_pose())
+        v, w, done = command(driver.base_pose())
         if done:
             break
-        robot.drive(v, w, 0.3)
-        robot.sleep(0.1)
+        driver.drive(v, w)
         t += 0.1
-    robot.drive(0.0, 0.0, 0.3)
-    robot.sleep(1.0)  # the ramp down
+    for _ in range(10):
+        driver.drive(0.0, 0.0)
 
 
-def _turn_to(robot: SimRobot, yaw: float) -> None:
+def _turn_to(driver: Driver, yaw: float) -> None:
     def cmd(p):
         err = _wrap(yaw - p[2])
         return 0.0, float(np.clip(1.5 * err, -0.6, 0.6)), abs(err) < 0.01
 
-    _drive_loop(robot, cmd)
+    _drive_loop(driver, cmd)
 
 
-def _go_point(robot: SimRobot, xy: np.ndarray, speed: float = 0.5) -> None:
+def _go_point(driver: Driver, xy: np.ndarray, speed: float = 0.5) -> None:
     def heading(p):
         d = xy - p[:2]
         return math.atan2(d[1], d[0])
 
-    if np.linalg.norm(xy - robot.base_pose()[:2]) > 0.02:
-        _turn_to(robot, heading(robot.base_pose()))
+    if np.linalg.norm(xy - driver.base_pose()[:2]) > 0.02:
+        _turn_to(driver, heading(driver.base_pose()))
 
     def cmd(p):
         d = xy - p[:2]
@@ -240,4 +267,4 @@ def _go_point(robot: SimRobot, xy: np.ndarray, speed: float = 0.5) -> None:
         v = min(speed, 0.8 * dist) * max(0.0, math.cos(err))
         return v, float(np.clip(1.5 * err, -0.6, 0.6)) if dist > 0.05 else 0.0, dist < 0.01
 
-    _drive_loop(robot, cmd)
+    _drive_loop(driver, cmd)

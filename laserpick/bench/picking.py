@@ -1,223 +1,324 @@
-"""One scripted pick-and-drop trial, as 004 section 8.1 ran them: the operator marks an object
-with the laser, the robot perceives, finds grasps, picks and drops the object in the basket,
-and the referee scores it. Shared by the picking benchmarks.
+"""The scripted operator of the benchmarks, working through the `Session` as every input does.
+
+It plays the user of 004's experiments: it looks at the scene (the simulator's truth says
+where each object is and how it looks from the cameras), aims the laser at an object's visible
+top with hand-tremor noise, confirms, and, in manual selection, steps through the grasp
+clusters to one on the object it meant, the way a person looking at the outlines would. Every
+command goes through the session's methods with `Actor("bench")`; the pipeline behind it never
+sees the truth. The `Referee` then scores what happened, and the experimenter (`tidy`) resets
+what a helper in the lab would: the basket emptied, a stuck arm moved home by hand.
+
+Units: m, s and rad; points in `base` unless a name says `world`.
 """
 
 from __future__ import annotations
 
+import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
-from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee, mark_and_capture
+from laserpick.bench.operator import TREMOR_STD, Referee
 from laserpick.description import dims
-from laserpick.pipeline.grasping import GraspSet, Strategy, find_grasps
-from laserpick.pipeline.perceive import Perception, perceive
-from laserpick.pipeline.types import Failure, Grasp
+from laserpick.pipeline.types import Failure
+from laserpick.robot.scenes import Scene
 from laserpick.robot.sim_robot import SimRobot
+from laserpick.server.session import Actor, Selection, Session, StrategyName, TaskState
+from laserpick.settings import Settings, get_settings
 
-#: The columns of the failure table: 004's kinds (Table 1), and "precondition" (e.g. no object
-#: at the mark).
-#: Marks the operator makes again after the mark itself failed (a missed dot, no object).
+BENCH = Actor("bench")
+#: Marks the operator makes again after the mark itself failed (the dots missed, or no object
+#: under them), as 004's users re-aimed.
 REMARKS = 2
-FAILURE_KINDS = (
-    "detect_laser",
-    "precondition",
-    "detect_grasp",
-    "ik_plan",
-    "wrong_object",
-    "execute",
-)
+#: Longest a session job may take (s of wall time) before the run is declared hung.
+JOB_TIMEOUT = 600.0
+#: The session's progress messages at the moment the hand lets go of the object.
+RELEASED = frozenset({"Released into the basket.", "Placed."})
 
 
 @dataclass
 class Attempt:
-    """The record of one marked object."""
+    """The record of one grasp attempt on one marked object (JSON-ready through `as_dict`)."""
 
+    trial: int
+    seed: int
     instance: str
     model: str
-    detected: bool = False  #: the grasp chosen was on the marked object
-    success: bool = False  #: the marked object ended up in the basket
-    failure: str | None = None  #: a FailureKind, when it did not succeed
+    surface: str | None
+    selection: str
+    strategy: str
+    task: int = 0  #: which task of the trial: the tries at one object share it
+    marks: int = 0  #: marks made (re-marks after a missed dot count)
+    detected: bool = False  #: the grasp chosen (or executed) was on the marked object
+    grasped: bool = False  #: the marked object was lifted and held
+    success: bool = False  #: the attempt's task was done (in the basket, or placed upright)
+    failure: str | None = None  #: one of FAILURE_KINDS when it did not succeed
     message: str = ""
-    timings: dict[str, float] = field(default_factory=dict)  #: s per pipeline stage
-    stuck: bool = False  #: the arm found no way home afterwards and was moved by hand
+    timings: dict[str, float] = field(default_factory=dict)  #: s per STAGES entry
+
+    def fail(self, kind: str, message: str) -> Attempt:
+        self.failure, self.message = kind, message
+        return self
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def trial_settings(seed: int) -> Settings:
+    """The settings of one trial: the defaults, with the session's and the sensors' random
+    draws seeded by the trial's seed (so a trial replays exactly)."""
+    settings = get_settings().model_copy(deep=True)
+    settings.server.seed = seed
+    settings.sensor.seed = seed
+    return settings
+
+
+def open_session(scene: Scene, seed: int, settle: float = 0.5) -> Session:
+    """A session on a headless (deterministic, faster than real time) robot in `scene`."""
+    settings = trial_settings(seed)
+    robot = SimRobot(scene, realtime=False, settings=settings)
+    robot.sim.settle(settle)
+    return Session(robot, settings=settings)
+
+
+class ScriptedOperator:
+    """The user and the experimenter of one trial, on one session.
+
+    rng: the operator's own draws (tremor, choices), seeded per trial.
+    tremor: the aim's angular noise, standard deviation (rad).
+    """
+
+    def __init__(
+        self,
+        session: Session,
+        rng: np.random.Generator,
+        *,
+        trial: int = 0,
+        seed: int = 0,
+        tremor: float = TREMOR_STD,
+    ) -> None:
+        self.session = session
+        self.rng = rng
+        self.trial, self.seed, self.tremor = trial, seed, tremor
+        self.actor = BENCH
+        self.referee = Referee(session.robot)
+        self._tasks = 0
+        self._events: list[dict[str, Any]] = []
+        # Stamped with the simulated time as they happen (listeners run on the emitting thread).
+        session.on_event(lambda e: self._events.append({**e, "sim_time": self._sim_time()}))
 
     @property
-    def decide_time(self) -> float:
-        """Grasp detection, filter, selection and planning (s): 004's 4.7 + 1.6 + 2.9 s."""
-        return sum(self.timings.get(k, 0.0) for k in ("detect", "filter", "select", "plan"))
+    def robot(self) -> SimRobot:
+        return self.session.robot
 
+    def _sim_time(self) -> float:
+        return float(self.robot.sim.snapshot().time)
 
-def stow(robot: SimRobot, behaviours: Behaviours) -> Failure | None:
-    """Empty the hand and fold the arm out of the cameras' view for the next capture.
+    # --- talking to the session -------------------------------------------------------------
 
-    When the arm finds no way back, the experimenter moves it home by hand (the simulator
-    sets the joints), so that one stuck attempt does not end the experiment; the failure is
-    returned for the attempt's record.
-    """
-    if robot.gripper_state().closed:
-        robot.gripper(False)
-        robot.sleep(1.0)
-    behaviours.held = None
-    out = behaviours.stow()
-    if out.ok:
-        return None
+    def wait(self) -> None:
+        """Wait until the session's job (if any) is over."""
+        end = time.monotonic() + JOB_TIMEOUT
+        while self.session.busy:
+            if time.monotonic() > end:
+                self.session.cancel(BENCH)
+                raise RuntimeError(f"a session job ran over {JOB_TIMEOUT:.0f} s; cancelled")
+            time.sleep(0.002)
 
-    def home(m, d) -> None:
-        d.qpos[robot.sim.info.arm_qpos] = dims.UR5_HOME_Q
-        d.qvel[robot.sim.info.arm_dof] = 0.0
+    def _events_since(self, k: int, name: str) -> list[dict[str, Any]]:
+        return [e for e in self._events[k:] if e.get("name") == name]
 
-    robot.sim.call(home)
-    robot.sim.halt()
-    robot.sleep(0.5)
-    return Failure("execute", f"the arm could not return home ({out.failure})")
+    def aim(self, point: np.ndarray) -> None:
+        """Aim the laser at `point` (m, `base`), off by the hand's tremor."""
+        self.session.aim_at(BENCH, point, "base")
+        dyaw, dpitch = self.rng.normal(0.0, self.tremor, 2)
+        self.session.nudge(BENCH, float(dyaw), float(dpitch))
 
+    def drive(self, v: float, w: float) -> None:
+        """Hold the drive command (m/s, rad/s) for 0.1 s of robot time: a joystick."""
+        self.session.drive(BENCH, v, w, 0.3)
+        self.robot.sleep(0.1)
 
-def mark_target(
-    robot: SimRobot, referee: Referee, instance: str, rng: np.random.Generator
-) -> Perception | Failure:
-    """The user marks `instance` and the robot perceives it. When the mark fails (the dot
-    missed, or no object under it), the user sees why and marks again, up to REMARKS times,
-    as 004's users re-aimed."""
-    aim = referee.aim_point(instance)
-    if aim is None:
-        return Failure("detect_laser", "no camera sees the object")
-    for _ in range(REMARKS + 1):
-        perception = perceive(mark_and_capture(robot, aim, rng))
-        if perception.ok:
-            return perception
-    assert perception.failure is not None
-    return perception.failure
+    def base_pose(self) -> np.ndarray:
+        """Where the scooter stands, (x, y, yaw) in `world`: the user sees it."""
+        return self.robot.base_pose()
 
+    # --- one attempt ------------------------------------------------------------------------
 
-def mark_and_pick(
-    robot: SimRobot,
-    behaviours: Behaviours,
-    referee: Referee,
-    instance: str,
-    rng: np.random.Generator,
-    *,
-    strategy: Strategy = "gpd",
-    choose: str = "auto",
-) -> Attempt:
-    """Mark `instance` and pick it; on success the hand holds it 10 cm up.
-
-    choose: "auto" tries the grasps in score order (004 section 7.4); "manual" plays a user
-    who steps through the clusters to the first whose best grasp is on the marked object
-    (004 section 7.2), and tries that cluster's grasps.
-    """
-    placements = robot.sim.scene.placements  # type: ignore[union-attr]
-    names = [p.instance for p in placements]
-    model = next(p.model.name for p in placements if p.instance == instance)
-    rec = Attempt(instance, model)
-    perception = mark_target(robot, referee, instance, rng)
-    if isinstance(perception, Failure):
-        rec.failure, rec.message = perception.kind, perception.message
-        return rec
-    rec.timings.update(perception.timings)
-    found = find_grasps(
-        perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q, strategy=strategy, rng=rng
-    )
-    if isinstance(found, Failure):
-        rec.failure, rec.message = found.kind, found.message
-        return rec
-    rec.timings.update(found.timings)
-    before = referee.all_object_points()  # judge the grasp against the scene it was made for
-    outcome = behaviours.pick(found, choose_order(found, choose, referee, instance, before))
-    rec.timings.update(outcome.timings)
-    if outcome.grasp is not None:
-        rec.detected = referee.grasped_object(outcome.grasp, names, before) == instance
-    if outcome.grasp is not None and not rec.detected:
-        rec.failure, rec.message = "wrong_object", "the chosen grasp was on another object"
-    elif outcome.failure is not None:
-        rec.failure, rec.message = outcome.failure.kind, outcome.failure.message
-    return rec
-
-
-def pick_and_drop(
-    robot: SimRobot,
-    behaviours: Behaviours,
-    referee: Referee,
-    instance: str,
-    rng: np.random.Generator,
-    *,
-    strategy: Strategy = "gpd",
-    choose: str = "auto",
-) -> Attempt:
-    """Mark `instance`, pick it and drop it in the basket; success is the simulator's word
-    that the marked object lies in the basket."""
-    rec = mark_and_pick(robot, behaviours, referee, instance, rng, strategy=strategy, choose=choose)
-    if rec.failure is not None or not rec.detected:
-        return rec
-    dropped = behaviours.drop_in_basket()
-    robot.sleep(1.0)
-    rec.success = referee.in_basket(instance)
-    if rec.success:
-        referee.take_out(instance)
-    else:
-        failure = dropped.failure or Failure("execute", "the object did not land in the basket")
-        rec.failure, rec.message = failure.kind, failure.message
-    return rec
-
-
-def choose_order(
-    found: GraspSet,
-    choose: str,
-    referee: Referee,
-    instance: str,
-    points: dict[str, np.ndarray] | None = None,
-) -> list[Grasp]:
-    """The grasps to try, in order, for automatic or (scripted) manual selection."""
-    if choose == "auto":
-        return found.ordered()
-    names = referee.instances()
-    grasps, clusters = found.clusters.grasps, found.clusters.clusters
-    for members in clusters:  # the user toggles through clusters, best first
-        if referee.grasped_object(grasps[members[0]], names, points) == instance:
-            return [grasps[i] for i in members]
-    return found.ordered()  # no cluster on the target: the user accepts the system's choice
-
-
-def run_scene(
-    robot: SimRobot,
-    instances: list[str],
-    rng: np.random.Generator,
-    *,
-    strategy: Strategy = "gpd",
-    choose: str = "auto",
-    log=lambda line: print(line, flush=True),
-) -> list[Attempt]:
-    """Pick-and-drop each instance in turn (in the given order) on a running scene."""
-    behaviours = Behaviours(robot, rng=rng, progress=lambda _msg: None)
-    referee = Referee(robot)
-    out = []
-    for name in instances:
-        t0 = time.perf_counter()
-        rec = pick_and_drop(robot, behaviours, referee, name, rng, strategy=strategy, choose=choose)
-        stuck = stow(robot, behaviours)
-        verdict = "ok" if rec.success else f"{rec.failure}: {rec.message}"
-        if stuck is not None:
-            rec.stuck = True
-            verdict += f"; then {stuck.message}, moved home by hand"
-        log(
-            f"  {name:<22} {verdict}  (decide {rec.decide_time * 1000:.0f} ms,"
-            f" wall {time.perf_counter() - t0:.1f} s)"
+    def new_attempt(self, instance: str, selection: Selection, strategy: StrategyName) -> Attempt:
+        placement = self.robot.sim.scene.placement(instance)  # type: ignore[union-attr]
+        self._tasks += 1
+        return Attempt(
+            self.trial,
+            self.seed,
+            instance,
+            placement.model.name,
+            placement.surface,
+            selection,
+            strategy,
+            task=self._tasks,
         )
-        out.append(rec)
-    return out
+
+    def mark(self, rec: Attempt, aim: np.ndarray | None = None) -> bool:
+        """Mark `rec.instance` until the session has grasps for it (True), or give up after
+        REMARKS re-marks, or on a failure that re-marking does not cure (the session then
+        rests idle; `rec` says why). aim: where to aim (m, `base`; default: the middle of the
+        object's visible top, where a person would aim)."""
+        s = self.session
+        aim = aim if aim is not None else self.referee.aim_point(rec.instance)
+        if aim is None:
+            rec.fail("detect_laser", "no camera sees the object")
+            return False
+        for _ in range(REMARKS + 1):
+            rec.marks += 1
+            self.aim(aim)
+            k = len(self._events)
+            s.confirm(BENCH)
+            self.wait()
+            rec.timings = _stages(self._events_since(k, "job"))
+            if s.state == TaskState.GRASPS_READY:
+                rec.failure, rec.message = None, ""  # an earlier mark's miss is behind us
+                return True
+            failure = s.failure or Failure("execute", f"the session rests {s.state.value}")
+            rec.fail(failure.kind, failure.message)
+            if s.state != TaskState.AIMING:  # found the object, but no grasp: not the aim
+                break
+        s.cancel(BENCH)
+        return False
+
+    def choose(self, instance: str, before: dict[str, np.ndarray]) -> None:
+        """Manual selection (004 section 7.2): step through the clusters, best first, to the
+        first whose best grasp closes on `instance`; none such: back to the system's choice."""
+        s = self.session
+        clusters = s.status()["grasps"]["clusters"]
+        for k in range(clusters):
+            s.select_grasp(BENCH, k, 0)
+            position = np.asarray(s.status()["current"]["position"])
+            if self.referee.object_at(position, before) == instance:
+                return
+        s.auto_grasp(BENCH)
+
+    def pick(self, rec: Attempt, aim: np.ndarray | None = None) -> bool:
+        """Mark `rec.instance`, choose a grasp the way `rec.selection` says, and execute.
+        In pick-and-drop the session carries the object to the basket and stows; in
+        pick-and-place it holds it up and awaits the place mark. True when the object was
+        lifted; `rec` has the verdict on detection and the failure, if any."""
+        s = self.session
+        s.set_mode(BENCH, selection=rec.selection, strategy=rec.strategy)  # type: ignore[arg-type]
+        if not self.mark(rec, aim):
+            return False
+        before = self.referee.all_object_points()  # judge grasps by the scene they were made for
+        if rec.selection == "manual":
+            self.choose(rec.instance, before)
+        chosen = np.asarray(s.status()["current"]["position"])
+        k = len(self._events)
+        t_sim = self._sim_time()
+        s.execute(BENCH)
+        self.wait()
+        execute_sim = self._released_at(k) - t_sim
+        done = self._events_since(k, "job")
+        rec.timings = _stages(done, execute_sim)  # the task's last job reports all its stages
+        executed = self._events_since(k, "grasp_executed")
+        if executed:
+            chosen = np.asarray(executed[-1]["grasp"]["position"])
+        rec.detected = self.referee.object_at(chosen, before) == rec.instance
+        lifted = any(e.get("state") == "holding" for e in self._events_since(k, "state"))
+        rec.grasped = lifted and rec.detected  # what was lifted was the marked object
+        if executed and not rec.detected:
+            rec.fail("wrong_object", "the grasp executed was on another object")
+        elif s.failure is not None:
+            rec.fail(s.failure.kind, s.failure.message)
+        return rec.grasped and rec.detected
+
+    def _released_at(self, k: int) -> float:
+        """Simulated time (s) the job begun at event `k` let go of the object (dropped or set
+        down), or now if it has not: the attempt's execution ends there, not after the stow."""
+        for e in self._events[k:]:
+            if e.get("name") == "progress" and e.get("message") in RELEASED:
+                return float(e["sim_time"])
+        return self._sim_time()
+
+    def pick_and_drop(self, rec: Attempt, aim: np.ndarray | None = None) -> Attempt:
+        """One 004 section 8.1 attempt: success is the simulator's word that the marked
+        object lies in the basket (it is then taken out, as a helper empties the basket).
+        aim: as for `mark`."""
+        self.session.set_mode(BENCH, mode="pick_and_drop")
+        if self.pick(rec, aim) and rec.failure is None:
+            self.robot.sleep(0.5)
+            rec.success = self.referee.in_basket(rec.instance)
+            if rec.success:
+                self.referee.take_out(rec.instance)
+            else:
+                rec.grasped = False  # 004 counts a grasp as successful once in the basket
+                rec.fail("execute", "the object did not land in the basket")
+        self.tidy()
+        return rec
+
+    def place(self, spot: np.ndarray) -> Placed:
+        """Mark `spot` (m, `base`) as where the held object goes, and let the session place it."""
+        s = self.session
+        if s.state != TaskState.AWAITING_PLACE:
+            failure = Failure("precondition", f"nothing to place (the session is {s.state.value})")
+            return Placed(failure, None)
+        self.aim(spot)
+        hits = self.robot.laser_hits()
+        hit = self.referee.to_base(hits[0]) if hits else None
+        s.confirm(BENCH)
+        self.wait()
+        if hit is None and s.failure is None:
+            return Placed(Failure("detect_laser", "the laser lit nothing"), None)
+        return Placed(s.failure, hit)
+
+    # --- the experimenter -------------------------------------------------------------------
+
+    def tidy(self) -> None:
+        """Reset what a failed attempt left: an object still in the hand is taken out of it
+        (and out of the scene), a stuck arm is moved home by hand, and the session is told."""
+        s, robot = self.session, self.robot
+        if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
+            held = s.behaviours.held
+            robot.gripper(False)
+            robot.sleep(1.0)
+            if held is not None:
+                for name in self.referee.instances():
+                    if self.referee.near_hand(name):
+                        self.referee.take_out(name)
+        if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
+            out = s.behaviours.stow() if not robot.gripper_state().closed else None
+            if out is None or not out.ok:
+                self.referee.move_arm_home()
+        s.resync(BENCH)
 
 
-def failure_table(attempts: list[Attempt]) -> str:
-    """004's Table 1 layout: per object, attempts, successes and the failures by kind."""
-    models = sorted({a.model for a in attempts})
-    head = f"{'object':<16}{'tries':>6}{'ok':>5}" + "".join(f"{k:>14}" for k in FAILURE_KINDS)
-    lines = [head, "-" * len(head)]
-    for m in [*models, "all"]:
-        rows = [a for a in attempts if m in ("all", a.model)]
-        counts = [sum(a.failure == k for a in rows) for k in FAILURE_KINDS]
-        ok = sum(a.success for a in rows)
-        lines.append(f"{m:<16}{len(rows):>6}{ok:>5}" + "".join(f"{c:>14}" for c in counts))
-    return "\n".join(lines)
+@dataclass(frozen=True)
+class Placed:
+    """How a place went: the session's failure (None: placed), and where the laser dot was
+    (m, `base`, simulator truth) when the place mark was confirmed."""
+
+    failure: Failure | None
+    hit: np.ndarray | None
+
+
+def _stages(jobs: list[dict[str, Any]], execute_sim: float | None = None) -> dict[str, float]:
+    """The STAGES timings of one attempt from its session jobs' reports (the last report of
+    a task holds all its stages)."""
+    raw: dict[str, float] = {}
+    for job in jobs:
+        raw.update(job.get("timings", {}))
+    out = {
+        "acquire_cloud": raw.get("capture", 0.0) + raw.get("fuse", 0.0),
+        "detect_laser": raw.get("detect_laser"),
+        "segment": raw.get("segment"),
+        "detect_grasp": raw.get("detect"),
+        "filter": raw.get("filter"),
+        "select": raw.get("select"),
+        "plan": raw.get("plan"),
+        "execute_sim": execute_sim,
+    }
+    timings = {k: float(v) for k, v in out.items() if v is not None}
+    if "fuse" not in raw:
+        timings.pop("acquire_cloud")
+    timings["attempt_total"] = math.fsum(timings.values())
+    return timings

@@ -25,7 +25,7 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.plan import PickPlan, plan_pick
+from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.selection import GraspClusters, group, score
 from laserpick.pipeline.types import Failure, Grasp
@@ -195,9 +195,11 @@ def plan_first(
     it there already. Returns the plan (or the last failure), its grasp and how many grasps
     were tried.
     """
+    s = settings or get_settings().motion
     at_ready = np.max(np.abs(q_now - UR5_READY_Q)) < READY_TOLERANCE
     via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
+    searches = Searches(s.rrt_max_failed)
     tried = 0
     for grasp in found.ordered() if order is None else order:
         tried += 1
@@ -209,10 +211,14 @@ def plan_first(
             found.world,
             found.surroundings,
             rng,
-            settings,
+            s,
             via=via,
             check_hand=found.strategy == "vertical",
+            searches=searches,
         )
         if not isinstance(plan, Failure):
             return plan, grasp, tried
+        if searches.spent:
+            msg = f"No collision-free path in {searches.failed} searches; no more were tried"
+            return Failure("ik_plan", msg), None, tried
     return plan, None, tried

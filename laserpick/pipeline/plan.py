@@ -14,7 +14,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -155,6 +155,36 @@ def joint_path(
     return None if path is None else shortcut(path, checker, rng, **kw)
 
 
+@dataclass
+class Searches:
+    """The joint-space searches of one pick, shared by the grasps it tries: a leg already
+    searched is reused (the leg from the stowed arm to the ready pose is the same for every
+    grasp), and failed searches are counted, so the pick can stop after `max_failed`."""
+
+    max_failed: int
+    failed: int = 0
+    legs: dict[tuple[bytes, bytes], np.ndarray | None] = field(default_factory=dict)
+
+    def path(
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        checker: CollisionChecker,
+        rng: np.random.Generator,
+        s: MotionSettings,
+    ) -> np.ndarray | None:
+        """`joint_path` from a to b with the hand checked, searched once per pick."""
+        key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
+        if key not in self.legs:
+            self.legs[key] = joint_path(a, b, checker, rng, s, hand=True)
+            self.failed += self.legs[key] is None
+        return self.legs[key]
+
+    @property
+    def spent(self) -> bool:
+        return self.failed >= self.max_failed
+
+
 def timed(
     path: np.ndarray,
     s: MotionSettings,
@@ -201,6 +231,7 @@ def plan_pick(
     settings: MotionSettings | None = None,
     via: Sequence[np.ndarray] = (),
     check_hand: bool = True,
+    searches: Searches | None = None,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
@@ -208,6 +239,7 @@ def plan_pick(
     the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
     already tested the hand's exact shape there (GPD, EL-E's sweep) may skip it.
+    searches: the pick's joint-space searches so far, when several grasps are tried.
 
     world: the whole cloud; surroundings: the cloud less the target. The arm is checked
     against the world all the way. The hand is checked against the world on the transit; on
@@ -218,6 +250,7 @@ def plan_pick(
     lift only the arm is checked against the surroundings, as the hand rises from its grasp.
     """
     s = settings or get_settings().motion
+    searches = searches or Searches(s.rrt_max_failed)
     if (
         check_hand
         and not surroundings.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]
@@ -244,7 +277,7 @@ def plan_pick(
     clear = [q for q in via if world.clearance_ok(q)[0]]
     legs = [q_now, clear[0], q_pre] if clear else [q_now, q_pre]
     for a, b in itertools.pairwise(legs):
-        leg = joint_path(a, b, world, rng, s, hand=True)
+        leg = searches.path(a, b, world, rng, s)
         if leg is None:
             transit = None
             break

@@ -334,6 +334,7 @@ class Session:
 
     def _run_job(self, actor: Actor, name: str, job: Callable[[], None]) -> None:
         t0 = time.perf_counter()
+        task = self.task  # a finished job replaces self.task; its timings are this one's
         try:
             job()
         except Exception as exc:  # a bug in a job must leave the robot at rest, not running
@@ -345,12 +346,13 @@ class Session:
         finally:
             with self._lock:
                 self._motion_token = None
-                self.task.timings[f"{name}_total"] = time.perf_counter() - t0
+                task.timings[f"{name}_total"] = time.perf_counter() - t0
+                timings = {k: round(v, 4) for k, v in task.timings.items()}
                 outcome = (
                     "cancelled" if self._cancel.is_set() else "failed" if self.failure else "done"
                 )
-                self._record(actor, name, outcome, self.failure, self.message, self.task.timings)
-                self._emit("job", job=name, outcome=outcome, message=self.message)
+                self._record(actor, name, outcome, self.failure, self.message, timings)
+                self._emit("job", job=name, outcome=outcome, message=self.message, timings=timings)
 
     # --- the laser --------------------------------------------------------------------------
 
@@ -531,6 +533,21 @@ class Session:
                 self._set(TaskState.HOLDING, "Holding. Execute drops it in the basket.")
             self._record(actor, "cancel", "ok")
 
+    def resync(self, actor: Actor) -> None:
+        """After a person stepped in by hand (took the object out of the gripper, or moved the
+        arm): forget the task and rest in the state the robot now shows, holding or idle."""
+        with self._lock:
+            if self.busy:
+                raise self._refuse(actor, "resync", f"busy ({self._job_name}); cancel it first")
+            if not self.robot.gripper_state().holding:
+                self.behaviours.held = None
+            self.task = _Task()
+            self._projection = None
+            self.failure = None
+            state = self._resting_state()
+            self._set(state, "Holding." if state == TaskState.HOLDING else "Ready.")
+            self._record(actor, "resync", "ok")
+
     def drive(self, actor: Actor, v: float, w: float, duration: float) -> None:
         """Drive the base at v (m/s) and w (rad/s) for at most `duration` s (<= 0.5 s: a
         dead-man; send it again to keep going). What was perceived is stale afterwards."""
@@ -629,12 +646,14 @@ class Session:
         """Capture, find the mark in the IR images, segment. With `point` (a confirming click,
         m in `base`), the mark is that point, and a capture still fresh from aiming is used."""
         fresh = self._fresh_capture() if point is not None else None
+        t0 = time.perf_counter()
         frames = list(fresh.frames) if fresh is not None else self.robot.capture()
+        captured = time.perf_counter() - t0
         perception = perceive(frames, point=point, settings=self.settings.perception)
         self._remember(frames, perception.cloud)
         lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
         with self._lock:
-            self.task.timings = dict(perception.timings)
+            self.task.timings = {"capture": captured, **perception.timings}
             if self._cancel.is_set():
                 self.robot.laser.off()
                 self.task = _Task()
@@ -691,6 +710,8 @@ class Session:
         assert grasps is not None
         out = self.behaviours.pick(grasps, order)
         self.task.timings.update(out.timings)
+        if out.grasp is not None:  # the grasp that planned: in auto, not always the first
+            self._emit("grasp_executed", grasp=grasp_summary(out.grasp), tried=out.attempts)
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)

@@ -1,0 +1,418 @@
+"""The papers' experiments as benchmark protocols, one trial at a time.
+
+Each protocol is a function of (trial index, seed, options) that builds its scene, runs one
+trial through a `Session` with the `ScriptedOperator`, and returns the trial's `Attempt`s. A
+trial depends on nothing but its arguments, so trials can run in any process, on any machine,
+in any order, and give the same attempts for the same seed.
+
+- isolation (004 section 8.1): the six objects of an `isolation` scene, marked in a random
+  order, picked and dropped in the basket.
+- in-situ (004 section 8.2): ten of the `kitchen` objects; the user drives from the start to
+  each object's surface and tries until the object is in the basket (at most MAX_TRIES).
+- pick-place (004 section 8.3): every `kitchen` object, upright or on its side by coin flip;
+  the user drives to it, the robot picks it (manual selection), the user drives to another
+  surface and marks a free spot, and the robot sets it down there.
+- selection (004 section 8.4): two objects side by side; one attempt with automatic and one
+  with manual selection, each from the same start.
+- surfaces (000 section 5.1): the phone and the pill on each of the twelve surfaces of the
+  `surfaces` scene, with EL-E's overhead grasp.
+- jeeves (003 section V): one object per trial (ten models in turn) on each of the `jeeves`
+  table's six locations, the scooter 40 cm back; the centroid approach, then a top grasp.
+- laser-scan (002 section II.D): the laser stepped across each object of an `isolation` scene
+  on a 1.5 cm grid; one grasp attempt per point, the object put back after each.
+
+With `--scene FILE`, a protocol runs on the user's scene instead of its own: its objects
+are worked through in the protocol's way (for selection, each trial marks one random object).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+import yaml
+
+from laserpick.bench.operator import (
+    PARK_SPOT_DEPTH,
+    drive_to,
+    parking_pose,
+    scene_config_backed,
+)
+from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
+from laserpick.bench.truth import Captured
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.types import Failure
+from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
+from laserpick.robot.scenes import Scene, Surface, load_scene, parse_scene, scene_config
+from laserpick.server.session import Selection, StrategyName, TaskState
+from laserpick.transforms import invert, matrix_from_quat, planar_pose
+
+#: Tries per object in the in-situ protocol (004 section 8.2 retried until retrieved).
+MAX_TRIES = 3
+#: A placed object counts as upright when its up axis is tilted under this (rad) from how it
+#: stood before, and as on target within this distance (m) of the mark plus its offset.
+UPRIGHT_TILT = math.radians(15.0)
+PLACE_TOLERANCE = 0.03
+#: The laser-scan protocol's step between aim points (m), 002's "about 1.5 cm".
+SCAN_STEP = 0.015
+#: The models of the two-object selection trials: the `isolation` set less the tall cereal
+#: box, which would hide its neighbour from every camera.
+PAIR_MODELS = [m for m in scene_config("isolation")["random"][0]["models"] if m != "cereal_box"]
+#: The ten objects of the Jeeves protocol, one per trial in turn (003 used ten household
+#: objects; these are ours that fit a vertical grasp).
+JEEVES_MODELS = (
+    "soda_can",
+    "mug",
+    "pill_bottle",
+    "spice_jar",
+    "juice_bottle",
+    "tea_box",
+    "glass_cup",
+    "marker",
+    "ball",
+    "spray_bottle",
+)
+JEEVES_BACK = 0.40  #: m the scooter starts behind its working spot (003's approach)
+IN_SITU_OBJECTS = 10
+
+
+@dataclass(frozen=True)
+class Options:
+    """What a run varies. scene: a user scene file instead of the protocol's own; tremor_deg:
+    the aim's angular noise (deg, standard deviation); objects: work through at most this
+    many objects per trial (None: all; for quick runs)."""
+
+    selection: Selection = "auto"
+    strategy: StrategyName = "gpd"
+    scene: str | None = None
+    tremor_deg: float = 0.3
+    objects: int | None = None
+
+
+TrialFn = Callable[[int, int, Options], list[Attempt]]
+
+
+@dataclass(frozen=True)
+class Protocol:
+    name: str
+    source: str  #: the paper and section it reruns
+    trials: int  #: the paper's number of trials
+    selection: Selection  #: the default selection mode
+    strategy: StrategyName  #: the default grasp strategy
+    run: TrialFn
+
+
+@contextmanager
+def _operated(scene: Scene, trial: int, seed: int, opt: Options) -> Iterator[ScriptedOperator]:
+    session = open_session(scene, seed)
+    try:
+        yield ScriptedOperator(
+            session,
+            np.random.default_rng(seed),
+            trial=trial,
+            seed=seed,
+            tremor=math.radians(opt.tremor_deg),
+        )
+    finally:
+        session.close()
+
+
+def _scene(default: str, seed: int, opt: Options) -> Scene:
+    return load_scene(opt.scene or default, seed=seed)
+
+
+def _limit(names: list[str], opt: Options) -> list[str]:
+    return names if opt.objects is None else names[: opt.objects]
+
+
+def _shuffled(op: ScriptedOperator, names: list[str]) -> list[str]:
+    names = list(names)
+    op.rng.shuffle(names)
+    return names
+
+
+def _instances(scene: Scene) -> list[str]:
+    return [p.instance for p in scene.placements]
+
+
+# --- isolation and laser-scan -------------------------------------------------------------
+
+
+def isolation(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    scene = _scene("isolation", seed, opt)
+    with _operated(scene, trial, seed, opt) as op:
+        order = _limit(_shuffled(op, _instances(scene)), opt)
+        return [op.pick_and_drop(op.new_attempt(n, opt.selection, opt.strategy)) for n in order]
+
+
+def scan_points(captured: Captured, instance: str, step: float = SCAN_STEP) -> np.ndarray:
+    """Aim points across the object's visible top (m, `base`): one seen point per `step`
+    square of its footprint, the one nearest the square's centre, in scan order (rows along
+    x, then y). Empty when no camera sees the object."""
+    from laserpick.pipeline.cloud import fuse
+
+    cloud = fuse(captured.frames)
+    pts = cloud.points[captured.object_points(cloud, instance)]
+    if len(pts) == 0:
+        return np.zeros((0, 3))
+    top = pts[pts[:, 2] > pts[:, 2].max() - 0.02]  # what the laser can land on from above
+    cells = np.floor(top[:, :2] / step).astype(np.int64)
+    centres = (cells + 0.5) * step
+    dist = np.linalg.norm(top[:, :2] - centres, axis=1)
+    best: dict[tuple[int, int], int] = {}
+    for i, key in enumerate(map(tuple, cells)):
+        if key not in best or dist[i] < dist[best[key]]:
+            best[key] = i
+    return np.array([top[best[k]] for k in sorted(best)])
+
+
+def laser_scan(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    scene = _scene("isolation", seed, opt)
+    out = []
+    with _operated(scene, trial, seed, opt) as op:
+        frames, labels = op.robot.capture_with_labels()
+        captured = Captured(op.robot, frames, labels)
+        for name in _limit(_instances(scene), opt):
+            home = op.referee.free_joint(name)
+            for point in scan_points(captured, name):
+                rec = op.new_attempt(name, opt.selection, opt.strategy)
+                out.append(op.pick_and_drop(rec, aim=point))
+                op.referee.put_back(name, home)  # the next point finds it where it stood
+    return out
+
+
+# --- selection ----------------------------------------------------------------------------
+
+_PAIR = """
+name: pair
+description: two objects side by side (004 section 8.4)
+scooter: {{x: 0.0, y: 0.0, yaw_deg: 0.0}}
+surfaces:
+  - {{name: table, kind: table, xy: [1.60, -0.15], yaw_deg: 0, size: [0.6, 1.0], height: 0.46}}
+objects:
+  - {{name: {a}, model: {a}, on: table, xy: [{ax:.4f}, {ay:.4f}], yaw_deg: {ayaw:.1f}}}
+  - {{name: {b}, model: {b}, on: table, xy: [{bx:.4f}, {by:.4f}], yaw_deg: {byaw:.1f}}}
+"""
+PAIR_FIRST_XY = np.array([1.50, -0.36])  #: m, world: the first object, in front of the arm
+PAIR_GAP = (0.0, 0.01)  #: m between the two objects, drawn uniformly: touching to 1 cm apart
+
+
+def _reach(name: str, yaw: float, d: np.ndarray) -> float:
+    """How far (m) the object's footprint (as the scene checks overlaps) reaches along the
+    world direction `d` (unit, 2D) from its centre, at `yaw` (rad)."""
+    model = LIBRARY[name]
+    half = footprint_half_extents(model, rest_pose(model))
+    c, s = math.cos(yaw), math.sin(yaw)
+    return float(half[0] * abs(c * d[0] + s * d[1]) + half[1] * abs(-s * d[0] + c * d[1]))
+
+
+def pair_scene(rng: np.random.Generator) -> Scene:
+    """Two random models at random yaws, the second beside the first (+y), 0-1 cm apart."""
+    a, b = (str(m) for m in rng.choice(PAIR_MODELS, size=2, replace=False))
+    ya, yb = rng.uniform(0, 2 * math.pi, 2)
+    d = np.array([0.0, 1.0])
+    xy_b = PAIR_FIRST_XY + d * (_reach(a, ya, d) + _reach(b, yb, -d) + rng.uniform(*PAIR_GAP))
+    text = _PAIR.format(
+        a=a,
+        b=b,
+        ax=PAIR_FIRST_XY[0],
+        ay=PAIR_FIRST_XY[1],
+        ayaw=math.degrees(ya),
+        bx=xy_b[0],
+        by=xy_b[1],
+        byaw=math.degrees(yb),
+    )
+    return parse_scene(text)
+
+
+def selection(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    rng = np.random.default_rng(seed)
+    scene = _scene("", seed, opt) if opt.scene else pair_scene(rng)
+    target = str(rng.choice(_instances(scene)))
+    out = []
+    for mode in ("auto", "manual"):
+        with _operated(scene, trial, seed, opt) as op:  # the same start for both modes
+            out.append(op.pick_and_drop(op.new_attempt(target, mode, opt.strategy)))
+    return out
+
+
+# --- driving: surfaces, in-situ, pick-place ------------------------------------------------
+
+
+def surfaces(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    scene = _scene("surfaces", seed, opt)
+    out = []
+    with _operated(scene, trial, seed, opt) as op:
+        start = op.base_pose().copy()
+        first = scene.surfaces[0]
+        for surface in scene.surfaces:
+            names = [p.instance for p in scene.placements if p.surface == surface.name]
+            if not names:
+                continue
+            if opt.scene is None:  # the surfaces stand in a row along +y, each set out alike
+                goal = start + [0.0, surface.xy[1] - first.xy[1], 0.0]
+            else:
+                goal = parking_pose(surface, _local_y(surface, scene, names[0]))
+            if np.linalg.norm(op.base_pose()[:2] - goal[:2]) > 0.03:
+                drive_to(op, goal, reverse_first=0.6)
+            for name in names:
+                out.append(op.pick_and_drop(op.new_attempt(name, opt.selection, opt.strategy)))
+                if opt.objects is not None and len(out) >= opt.objects:
+                    return out
+    return out
+
+
+def _local_y(surface: Surface, scene: Scene, instance: str) -> float:
+    """The object's position across the surface's width (m, the surface's frame)."""
+    return float(surface.to_local(scene.placement(instance).pos[:2])[1])
+
+
+def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str) -> bool:
+    """Drive from wherever the scooter is to park in front of the object's surface, the
+    object before the arm. Returns whether it parked."""
+    placement = scene.placement(instance)
+    surface = scene.surface(placement.surface)
+    goal = parking_pose(surface, _local_y(surface, scene, instance))
+    if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
+        return True
+    return drive_to(op, goal, reverse_first=0.6)
+
+
+def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    scene = _scene("kitchen", seed, opt)
+    out = []
+    with _operated(scene, trial, seed, opt) as op:
+        names = _shuffled(op, _instances(scene))[:IN_SITU_OBJECTS]
+        for task, name in enumerate(_limit(names, opt)):
+            parked = _go_to_object(op, scene, name)
+            for _ in range(MAX_TRIES):
+                rec = op.new_attempt(name, opt.selection, opt.strategy)
+                rec.task = task
+                if not parked:
+                    rec.fail("precondition", "the user could not park in front of it")
+                    out.append(rec)
+                    break
+                out.append(op.pick_and_drop(rec))
+                if rec.success or _gone(op, name):
+                    break
+    return out
+
+
+def _gone(op: ScriptedOperator, name: str) -> bool:
+    """Whether the object has left its surface (fallen to the floor, or taken out)."""
+    return bool(op.referee.world_position(name)[2] < 0.02)
+
+
+def _coin_flip_kitchen(rng: np.random.Generator) -> Scene:
+    """The `kitchen` scene with each object upright or on its side by a coin flip."""
+    config = scene_config("kitchen")
+    for obj in config["objects"]:
+        obj["lying"] = bool(rng.integers(2))
+    return parse_scene(yaml.safe_dump(config, sort_keys=False))
+
+
+def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray] | None:
+    """A spot on `surface` 25 cm behind its front edge and 15 cm from every object: (local y,
+    world xyz on the lowest level). None when the surface has no such spot."""
+    half_w = surface.size[1] / 2 - 0.15
+    objects = [op.referee.world_position(n) for n in op.referee.instances()]
+    level = surface.levels[0]
+    for _ in range(100):
+        ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
+        xy = surface.to_world(np.array([-surface.size[0] / 2 + PARK_SPOT_DEPTH, ly]))
+        if all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1):
+            return ly, np.array([xy[0], xy[1], level])
+    return None
+
+
+def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    rng = np.random.default_rng(seed)
+    scene = _scene("", seed, opt) if opt.scene else _coin_flip_kitchen(rng)
+    out = []
+    with _operated(scene, trial, seed, opt) as op:
+        for name in _limit(_shuffled(op, _instances(scene)), opt):
+            rec = op.new_attempt(name, opt.selection, opt.strategy)
+            out.append(_move_object(op, scene, rec))
+            op.tidy()
+    return out
+
+
+def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
+    """One 004 section 8.3 task: pick `rec.instance` and set it down on another surface."""
+    session, referee = op.session, op.referee
+    if not _go_to_object(op, scene, rec.instance):
+        return rec.fail("precondition", "the user could not park in front of it")
+    session.set_mode(op.actor, mode="pick_and_place")
+    up_before = matrix_from_quat(referee.world_quat(rec.instance))[:, 2]
+    if not op.pick(rec) or rec.failure is not None:
+        return rec
+    if session.state != TaskState.AWAITING_PLACE:
+        return rec.fail("execute", f"the session is {session.state.value}, not awaiting a mark")
+    # Where the object sits relative to the TCP, as it will when set down (m, `base` xy: the
+    # place keeps the grasp's orientation in `base`).
+    offset = (referee.position(rec.instance) - tcp_pose(op.robot.joint_state().q)[:3, 3])[:2]
+    here = scene.placement(rec.instance).surface
+    dests = [s for s in scene.surfaces if s.name != here]
+    dest = dests[int(op.rng.integers(len(dests)))] if dests else scene.surface(here)
+    spot = free_spot(op, dest)
+    if spot is None:
+        return rec.fail("precondition", f"no free spot on {dest.name}")
+    local_y, spot_world = spot
+    if not drive_to(op, parking_pose(dest, local_y), reverse_first=0.6):
+        return rec.fail("precondition", f"the user could not park at {dest.name}")
+    spot_base = (invert(planar_pose(*op.base_pose())) @ np.append(spot_world, 1.0))[:3]
+    placed = op.place(spot_base)
+    if placed.failure is not None or placed.hit is None:
+        failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
+        return rec.fail(failure.kind, failure.message)
+    op.robot.sleep(0.5)
+    error = float(np.linalg.norm(referee.position(rec.instance)[:2] - placed.hit[:2] - offset))
+    up_now = matrix_from_quat(referee.world_quat(rec.instance))[:, 2]
+    tilt = math.acos(float(np.clip(up_before @ up_now, -1.0, 1.0)))
+    rec.surface = f"{here} -> {dest.name}"
+    if tilt > UPRIGHT_TILT:
+        return rec.fail("execute", f"set down tilted {math.degrees(tilt):.0f} deg")
+    if error > PLACE_TOLERANCE:
+        return rec.fail("execute", f"set down {error * 100:.1f} cm from the mark")
+    rec.success = True
+    return rec
+
+
+# --- jeeves -------------------------------------------------------------------------------
+
+
+def jeeves_scene(model: str, location: str, back: float = JEEVES_BACK) -> Scene:
+    """The `jeeves` table with `model` on `location` and the scooter `back` m farther away."""
+    config = scene_config_backed("jeeves", back)
+    config["objects"] = [{"name": model, "model": model, "at": location}]
+    return parse_scene(yaml.safe_dump(config, sort_keys=False))
+
+
+def jeeves(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    if opt.scene:
+        return isolation(trial, seed, opt)
+    model = JEEVES_MODELS[trial % len(JEEVES_MODELS)]
+    out = []
+    for k, location in enumerate(_limit([f"loc{i}" for i in range(1, 7)], opt)):
+        with _operated(jeeves_scene(model, location), trial, seed * 10 + k, opt) as op:
+            rec = op.new_attempt(model, opt.selection, opt.strategy)
+            rec.surface = location
+            out.append(op.pick_and_drop(rec))
+    return out
+
+
+PROTOCOLS: dict[str, Protocol] = {
+    p.name: p
+    for p in (
+        Protocol("isolation", "004 section 8.1, Tables 1-2", 15, "auto", "gpd", isolation),
+        Protocol("in-situ", "004 section 8.2, Tables 3-4", 5, "auto", "gpd", in_situ),
+        Protocol("pick-place", "004 section 8.3, Tables 5-6", 3, "manual", "gpd", pick_place),
+        Protocol("selection", "004 section 8.4, Table 7", 50, "auto", "gpd", selection),
+        Protocol("surfaces", "000 (EL-E) section 5.1, Table 1", 1, "auto", "overhead", surfaces),
+        Protocol("jeeves", "003 (Jeeves) sections V-VI, Tables I-II", 10, "auto", "jeeves", jeeves),
+        Protocol("laser-scan", "002 sections II.D and III, Table I", 1, "auto", "gpd", laser_scan),
+    )
+}

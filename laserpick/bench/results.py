@@ -1,0 +1,121 @@
+"""A benchmark run's attempts summed up as the result JSON (the schema is in docs/bench.md).
+
+Rates (0-1):
+- detect_success_rate: attempts whose chosen grasp was on the marked object, over attempts;
+- grasp_success_rate: attempts in which the marked object was lifted and held (in
+  pick-and-drop, and dropped in the basket), over the attempts whose detection succeeded:
+  004 section 8.1 counts it so (93.8 % = 90/96, beside a detection success of 96/104);
+- task_success_rate: tasks done (the object in the basket, or set down upright on the mark),
+  over tasks. A task is one object to fetch or move; in-situ retries share one task.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Iterable, Sequence
+from datetime import UTC, datetime
+from typing import Any
+
+from laserpick.bench import FAILURE_KINDS, STAGES
+
+
+def _rate(k: int, n: int) -> float:
+    return k / n if n else 0.0
+
+
+def _failures(records: Iterable[dict[str, Any]]) -> dict[str, int]:
+    counts = dict.fromkeys(FAILURE_KINDS, 0)
+    for r in records:
+        if r["failure"] is not None:
+            counts[r["failure"]] += 1
+    return counts
+
+
+def _tasks(records: Sequence[dict[str, Any]]) -> dict[tuple, bool]:
+    """Whether each task (trial, selection, task id) was done by any of its attempts."""
+    done: dict[tuple, bool] = {}
+    for r in records:
+        key = (r["trial"], r["selection"], r["task"])
+        done[key] = done.get(key, False) or r["success"]
+    return done
+
+
+def _timings(records: Sequence[dict[str, Any]]) -> dict[str, dict[str, float]]:
+    """Mean, std and count per stage, over the attempts that reached it; attempt_total over
+    the successful attempts, as 004 gives "the average time to complete a successful
+    attempt" (section 8.2)."""
+    out = {}
+    for stage in STAGES:
+        rows = [r for r in records if r["success"]] if stage == "attempt_total" else records
+        xs = [r["timings"][stage] for r in rows if stage in r["timings"]]
+        out[stage] = {
+            "mean": statistics.fmean(xs) if xs else 0.0,
+            "std": statistics.pstdev(xs) if len(xs) > 1 else 0.0,
+            "n": len(xs),
+        }
+    return out
+
+
+def summarize(records: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The summary fields of a set of attempt records (`Attempt.as_dict()`s)."""
+    tasks = _tasks(records)
+    objects: dict[str, dict[str, Any]] = {}
+    for model in sorted({r["model"] for r in records}):
+        rows = [r for r in records if r["model"] == model]
+        model_tasks = _tasks(rows)
+        objects[model] = {
+            "attempts": len(rows),
+            "grasp_success": sum(r["grasped"] for r in rows),
+            "detect_success": sum(r["detected"] for r in rows),
+            "tasks": len(model_tasks),
+            "task_success": sum(model_tasks.values()),
+            "failures": _failures(rows),
+        }
+    n = len(records)
+    return {
+        "attempts": n,
+        "tasks": len(tasks),
+        "grasp_success_rate": _rate(
+            sum(r["grasped"] for r in records), sum(r["detected"] for r in records)
+        ),
+        "detect_success_rate": _rate(sum(r["detected"] for r in records), n),
+        "task_success_rate": _rate(sum(tasks.values()), len(tasks)),
+        "failures": _failures(records),
+        "timings_s": _timings(records),
+        "objects": objects,
+    }
+
+
+def result(
+    protocol: str,
+    seed: int,
+    trials: int,
+    records: Sequence[dict[str, Any]],
+    options: dict[str, Any],
+    wall_time_s: float,
+) -> dict[str, Any]:
+    """The result JSON of a run: the summary over all attempts, per-mode summaries for the
+    selection protocol, and every attempt's record (sorted by trial, so the same seed gives
+    the same document whatever order the workers finished in)."""
+    from laserpick import __version__
+
+    records = sorted(records, key=lambda r: (r["trial"], r["task"], r["selection"]))
+    out: dict[str, Any] = {"protocol": protocol, "seed": seed, "trials": trials}
+    out.update(summarize(records))
+    out["options"] = options
+    if protocol == "selection":
+        out["modes"] = {
+            mode: summarize([r for r in records if r["selection"] == mode])
+            for mode in ("auto", "manual")
+        }
+    out["records"] = records
+    out["wall_time_s"] = round(wall_time_s, 1)
+    out["version"] = __version__
+    out["created"] = datetime.now(UTC).isoformat(timespec="seconds")
+    return out
+
+
+def outcomes(result: dict[str, Any]) -> list[tuple]:
+    """What the same seed must reproduce: each attempt's verdicts, without its timings."""
+    keys = ("trial", "instance", "selection", "marks", "detected", "grasped", "success", "failure")
+    return [tuple(r[k] for k in keys) for r in result["records"]]

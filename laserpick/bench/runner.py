@@ -1,0 +1,115 @@
+"""Run a protocol's trials: in this process, in local worker processes, or on a Ray cluster.
+
+Trial k of a run with seed s has seed s + k and depends on nothing else, so the three ways
+give the same attempts for the same seed (only the timings differ). Each worker process
+builds its own simulator; MuJoCo renders headless through EGL in each.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import sys
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict
+from typing import Any
+
+from laserpick.bench.protocols import PROTOCOLS, Options
+from laserpick.bench.results import result
+
+Record = dict[str, Any]
+
+
+def run_trial(protocol: str, trial: int, seed: int, options: Options) -> list[Record]:
+    """One trial's attempt records (JSON-ready). The unit of work a worker runs."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    attempts = PROTOCOLS[protocol].run(trial, seed, options)
+    return [a.as_dict() for a in attempts]
+
+
+def _local(
+    protocol: str, seeds: list[int], options: Options, workers: int
+) -> Iterator[list[Record]]:
+    if workers <= 1:
+        for trial, seed in enumerate(seeds):
+            yield run_trial(protocol, trial, seed, options)
+        return
+    # spawn: a fresh interpreter per worker, so no EGL context or thread is inherited
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        futures = [
+            pool.submit(run_trial, protocol, trial, seed, options)
+            for trial, seed in enumerate(seeds)
+        ]
+        for future in as_completed(futures):
+            yield future.result()
+
+
+def _ray(protocol: str, seeds: list[int], options: Options, address: str) -> Iterator[list[Record]]:
+    try:
+        import ray
+    except ImportError:
+        raise SystemExit(
+            "--ray needs Ray: pip install 'laserpick[ray]' (on every node of the cluster)"
+        ) from None
+    ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    remote = ray.remote(num_cpus=1)(run_trial)
+    pending = [remote.remote(protocol, trial, seed, options) for trial, seed in enumerate(seeds)]
+    while pending:
+        done, pending = ray.wait(pending, num_returns=1)
+        yield ray.get(done[0])
+
+
+def run(
+    protocol: str,
+    *,
+    trials: int | None = None,
+    seed: int = 1,
+    options: Options | None = None,
+    workers: int = 1,
+    ray_address: str | None = None,
+    progress: Callable[[int, int, list[Record]], None] | None = None,
+) -> dict[str, Any]:
+    """Run `trials` trials of `protocol` (default: the paper's number) and return the result
+    JSON. progress(done, total, records so far) is called after each finished trial."""
+    spec = PROTOCOLS[protocol]
+    options = options or Options(selection=spec.selection, strategy=spec.strategy)
+    n = spec.trials if trials is None else trials
+    seeds = [seed + k for k in range(n)]
+    t0 = time.perf_counter()
+    if ray_address:
+        source = _ray(protocol, seeds, options, ray_address)
+    else:
+        source = _local(protocol, seeds, options, workers)
+    records: list[Record] = []
+    if progress is not None:
+        progress(0, n, records)
+    for done, trial_records in enumerate(source, start=1):
+        records += trial_records
+        if progress is not None:
+            progress(done, n, records)
+    described = asdict(options) | {"workers": workers, "ray": ray_address}
+    return result(protocol, seed, n, records, described, time.perf_counter() - t0)
+
+
+def progress_bar(desc: str) -> Callable[[int, int, list[Record]], None]:
+    """A progress callback drawing a bar on stderr: trials done, attempts and successes."""
+    from tqdm import tqdm
+
+    bar: tqdm | None = None
+
+    def update(done: int, total: int, records: list[Record]) -> None:
+        nonlocal bar
+        if bar is None:
+            bar = tqdm(total=total, desc=desc, unit="trial", file=sys.stderr, initial=0)
+        if done == 0:
+            return
+        ok = sum(r["success"] for r in records)
+        bar.set_postfix_str(f"{ok}/{len(records)} attempts ok", refresh=False)
+        bar.update(1)
+        if done == total:
+            bar.close()
+
+    return update

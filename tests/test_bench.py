@@ -1,0 +1,144 @@
+"""The benchmark runner: protocols through the session, reproducible by seed in this process,
+in worker processes and on Ray, and the `laserpick bench` command's files."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from laserpick.bench import PROTOCOL_NAMES
+from laserpick.bench.protocols import PROTOCOLS, Options, scan_points
+from laserpick.bench.results import outcomes, summarize
+from laserpick.bench.runner import run
+from laserpick.bench.truth import capture
+from laserpick.pipeline.cloud import fuse
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_the_command_line_knows_every_protocol() -> None:
+    assert tuple(PROTOCOLS) == PROTOCOL_NAMES
+
+
+def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:
+    """Two selection trials (auto and manual on the same pair each): in this process, in two
+    spawned worker processes, and on a local Ray instance. The verdicts must agree."""
+    import ray
+
+    options = Options(selection="auto", strategy="gpd")
+    inline = run("selection", trials=2, seed=3, options=options, workers=1)
+    pooled = run("selection", trials=2, seed=3, options=options, workers=2)
+    try:
+        ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+        on_ray = run("selection", trials=2, seed=3, options=options, ray_address="auto")
+    finally:
+        ray.shutdown()
+    assert inline["attempts"] == 4
+    assert {r["selection"] for r in inline["records"]} == {"auto", "manual"}
+    assert set(inline["modes"]) == {"auto", "manual"}
+    assert outcomes(pooled) == outcomes(inline)
+    assert outcomes(on_ray) == outcomes(inline)
+    assert on_ray["options"]["ray"] == "auto"
+    for r in inline["records"]:  # each attempt was timed, stage by stage
+        if r["failure"] not in ("detect_laser", "precondition", "detect_grasp"):
+            assert r["timings"]["plan"] > 0
+            assert r["timings"]["attempt_total"] >= r["timings"]["plan"]
+
+
+def test_bench_command_on_a_user_mesh_scene(tmp_path: Path) -> None:
+    """`laserpick bench --scene` with OBJ and STL models: the JSON holds the schema's fields
+    and the attempts on the scene's objects, and the report and plots are written."""
+    out = tmp_path / "user.json"
+    cmd = [sys.executable, "-m", "laserpick.cli", "bench", "--protocol", "isolation"]
+    cmd += ["--trials", "1", "--objects", "2", "--scene", str(DATA / "user_scene.yaml")]
+    cmd += ["--out", str(out), "--workers", "1"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    result = json.loads(out.read_text())
+    for key in ("protocol", "seed", "trials", "attempts", "grasp_success_rate"):
+        assert key in result
+    assert set(result["failures"]) == {
+        "detect_laser",
+        "precondition",
+        "detect_grasp",
+        "ik_plan",
+        "wrong_object",
+        "execute",
+    }
+    assert result["attempts"] == len(result["records"]) == 2
+    assert result["options"]["scene"].endswith("user_scene.yaml")
+    scene_models = {"block", "hex_can", "soda_can"}
+    assert {r["model"] for r in result["records"]} <= scene_models
+    assert sum(result["failures"].values()) == sum(not r["success"] for r in result["records"])
+    assert set(result["timings_s"]) >= {"acquire_cloud", "detect_laser", "attempt_total"}
+    report = out.with_suffix(".md").read_text()
+    assert "isolation" in report and "93.8" in report  # ours beside 004's figure
+    pngs = sorted(tmp_path.glob("user*.png"))
+    assert len(pngs) == 2
+    for png in pngs:
+        with Image.open(png) as im:
+            assert im.width >= 600 and len(im.getcolors(1 << 20) or []) > 2
+    assert "isolation" in done.stderr  # the progress bar
+
+
+def test_bench_command_refuses_a_broken_scene(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\nsurfaces: [{name: t, kind: table}]\n")
+    cmd = [sys.executable, "-m", "laserpick.cli", "bench", "--protocol", "isolation"]
+    done = subprocess.run(cmd + ["--scene", str(bad)], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "bad.yaml" in done.stderr and "surfaces" in done.stderr
+    assert not (tmp_path / "bench-results").exists()
+
+
+def test_scan_points_step_across_the_visible_top() -> None:
+    """002's scan: aim points 1.5 cm apart over the object's top, all on the object."""
+    cap = capture("isolation", seed=1)
+    try:
+        name = next(p.instance for p in cap.scene.placements if p.model.name == "tv_remote")
+        pts = scan_points(cap, name)
+        on_it = cap.object_points(fuse(cap.frames), name)
+        seen = fuse(cap.frames).points[on_it]
+    finally:
+        cap.close()
+    assert 4 <= len(pts) <= 100, len(pts)  # an 18 x 5 cm remote, in 1.5 cm squares
+    gaps = np.linalg.norm(pts[:, None, :2] - pts[None, :, :2], axis=2)
+    np.fill_diagonal(gaps, np.inf)
+    assert gaps.min() > 0.005  # one point per 1.5 cm cell, near its centre
+    assert np.ptp(pts[:, 2]) < 0.025  # all on the top
+    nearest = np.linalg.norm(pts[:, None] - seen[None], axis=2).min(axis=1)
+    assert nearest.max() < 1e-6  # each is a point the cameras saw on the object
+
+
+def test_retries_at_one_object_count_as_one_task() -> None:
+    """In-situ tries until the object is fetched: two failed tries and a success are one
+    task done, and three attempts of which one succeeded."""
+
+    def rec(task: int, success: bool, failure: str | None) -> dict:
+        return {
+            "trial": 0,
+            "task": task,
+            "selection": "auto",
+            "model": "mug",
+            "detected": failure != "wrong_object",
+            "grasped": success,
+            "success": success,
+            "failure": failure,
+            "timings": {"plan": 0.1, "attempt_total": 1.0},
+        }
+
+    records = [rec(1, False, "ik_plan"), rec(1, False, "execute"), rec(1, True, None)]
+    records += [rec(2, False, "wrong_object")]
+    s = summarize(records)
+    assert s["attempts"] == 4 and s["tasks"] == 2
+    assert s["task_success_rate"] == pytest.approx(0.5)
+    assert s["detect_success_rate"] == pytest.approx(0.75)
+    assert s["grasp_success_rate"] == pytest.approx(1 / 3)
+    assert s["failures"]["ik_plan"] == 1 and s["failures"]["wrong_object"] == 1
+    assert s["objects"]["mug"]["task_success"] == 1
