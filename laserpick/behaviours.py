@@ -295,6 +295,8 @@ class Behaviours:
 
         Postures that hold every point of the object inside the opening (1 cm in from the
         walls) come first, then those that hold its middle there; then the nearest to q_ref.
+        None when no clear posture holds even the middle over the opening: an object let go
+        there would fall beside the basket, onto the scooter or the floor.
         The basket sits close beside the arm's base, between the tiller, the sensor posts and
         the projector, so few postures reach over it: they are searched, not assumed.
         """
@@ -310,7 +312,7 @@ class Behaviours:
             middle = xy.mean(axis=0)
             inside = 0 if np.all((xy >= lo) & (xy <= hi)) else 1
             if inside and not np.all((middle >= lo) & (middle <= hi)):
-                inside = 2
+                continue
             key = (inside, float(np.max(np.abs(q - q_ref))))
             if best is None or key < best[0]:
                 best = (key, q)
@@ -344,7 +346,8 @@ class Behaviours:
         held = self.held
         q_drop = self.drop_configuration(self._q(), held.surroundings, held.points_tcp)
         if q_drop is None:
-            return Outcome(Failure("ik_plan", "The arm cannot reach over the basket."))
+            msg = "The arm cannot hold the object over the basket; it keeps it."
+            return Outcome(Failure("ik_plan", msg))
         self.progress("Carrying the object to the basket.")
         failure = self._rise_clear(held)
         if failure is not None:

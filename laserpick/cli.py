@@ -20,8 +20,8 @@ behind the TLS proxy in deploy/.
 
 `bench` reruns one of the papers' experiments with the scripted operator (docs/bench.md).
 
-Exit codes: 0 clean shutdown (or a finished benchmark), 2 bad usage (unknown scene, refused
-host, a bad count).
+Exit codes: 0 clean shutdown (or a finished benchmark), 1 a benchmark trial broke off (the
+others' results are still written), 2 bad usage (unknown scene, refused host, a bad count).
 """
 
 from __future__ import annotations
@@ -273,6 +273,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     written = [out, *write_reports(result, out)]
     print(markdown(result))
     _say("wrote " + ", ".join(str(p) for p in written))
+    if result["errors"]:
+        _say(f"{len(result['errors'])} trials broke off (see 'errors' in {out})", err=True)
+        return 1
     return 0
 
 

@@ -3,6 +3,7 @@ in worker processes and on Ray, and the `laserpick bench` command's files."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -13,7 +14,8 @@ import pytest
 from PIL import Image
 
 from laserpick.bench import PROTOCOL_NAMES
-from laserpick.bench.protocols import PROTOCOLS, Options, scan_points
+from laserpick.bench.protocols import JEEVES_MODELS, PROTOCOLS, Options, jeeves_scene, scan_points
+from laserpick.bench.report import markdown
 from laserpick.bench.results import outcomes, summarize
 from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
@@ -24,6 +26,29 @@ DATA = Path(__file__).parent / "data"
 
 def test_the_command_line_knows_every_protocol() -> None:
     assert tuple(PROTOCOLS) == PROTOCOL_NAMES
+
+
+def test_every_jeeves_object_stands_at_every_location() -> None:
+    for model in JEEVES_MODELS:
+        for k in range(1, 7):
+            scene = jeeves_scene(model, f"loc{k}")
+            assert [p.model.name for p in scene.placements] == [model]
+
+
+def test_a_trial_that_breaks_off_is_reported_not_lost(monkeypatch) -> None:
+    """An exception in one trial is named with its seed; the other trials' records stay."""
+
+    def flaky(trial: int, seed: int, opt: Options) -> list:
+        if trial == 1:
+            raise RuntimeError("simulated breakage")
+        return []
+
+    spec = PROTOCOLS["isolation"]
+    monkeypatch.setitem(PROTOCOLS, "isolation", dataclasses.replace(spec, run=flaky))
+    out = run("isolation", trials=3, seed=10, workers=1)
+    assert len(out["errors"]) == 1
+    assert "trial 1 (seed 11)" in out["errors"][0] and "simulated breakage" in out["errors"][0]
+    assert "broke off" in markdown(out)
 
 
 def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:

@@ -61,17 +61,18 @@ SCAN_STEP = 0.015
 #: The models of the two-object selection trials: the `isolation` set less the tall cereal
 #: box, which would hide its neighbour from every camera.
 PAIR_MODELS = [m for m in scene_config("isolation")["random"][0]["models"] if m != "cereal_box"]
-#: The ten objects of the Jeeves protocol, one per trial in turn (003 used ten household
-#: objects; these are ours that fit a vertical grasp).
+#: The ten objects of the Jeeves protocol, one per trial in turn: 003 used ten household
+#: objects; these are ours that fit a vertical grasp and stand at every location of the
+#: 0.40 m table (a location is 5 cm from the table's front and side edges).
 JEEVES_MODELS = (
     "soda_can",
     "mug",
     "pill_bottle",
     "spice_jar",
     "juice_bottle",
-    "tea_box",
+    "yogurt_cup",
     "glass_cup",
-    "marker",
+    "vitamin_bottle",
     "ball",
     "spray_bottle",
 )
@@ -385,7 +386,8 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
 
 
 def jeeves_scene(model: str, location: str, back: float = JEEVES_BACK) -> Scene:
-    """The `jeeves` table with `model` on `location` and the scooter `back` m farther away."""
+    """The `jeeves` table with `model` on `location` and the scooter `back` m farther away
+    than in the scene file."""
     config = scene_config_backed("jeeves", back)
     config["objects"] = [{"name": model, "model": model, "at": location}]
     return parse_scene(yaml.safe_dump(config, sort_keys=False))
@@ -413,6 +415,6 @@ PROTOCOLS: dict[str, Protocol] = {
         Protocol("selection", "004 section 8.4, Table 7", 50, "auto", "gpd", selection),
         Protocol("surfaces", "000 (EL-E) section 5.1, Table 1", 1, "auto", "overhead", surfaces),
         Protocol("jeeves", "003 (Jeeves) sections V-VI, Tables I-II", 10, "auto", "jeeves", jeeves),
-        Protocol("laser-scan", "002 sections II.D and III, Table I", 1, "auto", "gpd", laser_scan),
+        Protocol("laser-scan", "002 sections II.D and III, Table I", 3, "auto", "gpd", laser_scan),
     )
 }

@@ -254,6 +254,11 @@ def _header(result: dict[str, Any], ref: Reference) -> list[str]:
         f"laserpick {result.get('version', '?')}; "
         f"created {result.get('created', '?')}.",
     ]
+    for error in result.get("errors") or []:
+        lines += [
+            "",
+            f"**A trial broke off, and its attempts are missing:** {error.splitlines()[0]}",
+        ]
     return lines
 
 

@@ -11,6 +11,7 @@ import multiprocessing
 import os
 import sys
 import time
+import traceback
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict
@@ -22,16 +23,22 @@ from laserpick.bench.results import result
 Record = dict[str, Any]
 
 
-def run_trial(protocol: str, trial: int, seed: int, options: Options) -> list[Record]:
-    """One trial's attempt records (JSON-ready). The unit of work a worker runs."""
+Outcome = tuple[list[Record], str | None]
+
+
+def run_trial(protocol: str, trial: int, seed: int, options: Options) -> Outcome:
+    """One trial's attempt records (JSON-ready), or why the trial broke off: the unit of work
+    a worker runs. A trial that raises is reported, not lost with the rest of the run."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    attempts = PROTOCOLS[protocol].run(trial, seed, options)
-    return [a.as_dict() for a in attempts]
+    try:
+        attempts = PROTOCOLS[protocol].run(trial, seed, options)
+    except Exception as exc:
+        detail = traceback.format_exc(limit=-3)
+        return [], f"trial {trial} (seed {seed}) broke off: {exc!r}\n{detail}"
+    return [a.as_dict() for a in attempts], None
 
 
-def _local(
-    protocol: str, seeds: list[int], options: Options, workers: int
-) -> Iterator[list[Record]]:
+def _local(protocol: str, seeds: list[int], options: Options, workers: int) -> Iterator[Outcome]:
     if workers <= 1:
         for trial, seed in enumerate(seeds):
             yield run_trial(protocol, trial, seed, options)
@@ -47,7 +54,7 @@ def _local(
             yield future.result()
 
 
-def _ray(protocol: str, seeds: list[int], options: Options, address: str) -> Iterator[list[Record]]:
+def _ray(protocol: str, seeds: list[int], options: Options, address: str) -> Iterator[Outcome]:
     try:
         import ray
     except ImportError:
@@ -84,14 +91,20 @@ def run(
     else:
         source = _local(protocol, seeds, options, workers)
     records: list[Record] = []
+    errors: list[str] = []
     if progress is not None:
         progress(0, n, records)
-    for done, trial_records in enumerate(source, start=1):
+    for done, (trial_records, error) in enumerate(source, start=1):
         records += trial_records
+        if error is not None:
+            errors.append(error)
+            print(f"laserpick bench: {error}", file=sys.stderr, flush=True)
         if progress is not None:
             progress(done, n, records)
     described = asdict(options) | {"workers": workers, "ray": ray_address}
-    return result(protocol, seed, n, records, described, time.perf_counter() - t0)
+    out = result(protocol, seed, n, records, described, time.perf_counter() - t0)
+    out["errors"] = errors
+    return out
 
 
 def progress_bar(desc: str) -> Callable[[int, int, list[Record]], None]:

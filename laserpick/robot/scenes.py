@@ -153,6 +153,9 @@ class SceneError(ValueError):
         text = "; ".join(f"{path}: {msg}" if path else msg for path, msg in problems)
         super().__init__(f"{file}: {text}")
 
+    def __reduce__(self) -> tuple[type[SceneError], tuple[str, list[tuple[str, str]]]]:
+        return SceneError, (self.file, self.problems)  # crosses process boundaries intact
+
 
 # --- the YAML schema ---------------------------------------------------------------------
 
