@@ -23,6 +23,9 @@ GRID_CELL = 0.01  #: m, EL-E's 2D occupancy grid resolution (000 section 4.4.1)
 RAISED_BAND = 0.005  #: m, "less than 5 mm below the point of maximum height" (000 4.4.2)
 GRASP_DEPTH = 0.02  #: m the pads reach below the top of the object (our choice)
 FLOOR_GAP = 0.003  #: m the fingertips stay above the support surface
+#: m above the support's fitted height within which its own points lie: depth noise at the
+#: scooter's 1-2 m ranges scatters them by several mm, and they are not obstacles. Ours.
+SUPPORT_BAND = 0.01
 
 
 def occupancy_pca(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -84,11 +87,11 @@ def overhead_grasp(
     z = max(surface_height + FLOOR_GAP + s.pad_depth / 2, top - GRASP_DEPTH)
     pose = _pose(np.array([xy[0], xy[1], z]), closing)
     # The support itself is below the fingertips: its points (and their noise) do not block.
-    above = scene[scene[:, 2] > surface_height + FLOOR_GAP]
+    above = scene[scene[:, 2] > surface_height + SUPPORT_BAND]
     blocked = sweep_collisions(pose, above, target, s)
     if blocked:
         return Failure(
-            "detect_grasp", f"an overhead grasp would hit {blocked} points on the way down"
+            "detect_grasp", f"An overhead grasp would hit {blocked} points on the way down."
         )
     return Grasp(pose=pose, width=min(width, s.width_max))
 
