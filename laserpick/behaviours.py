@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.approach import centroid_approach
-from laserpick.pipeline.collision import CollisionChecker, thin
+from laserpick.pipeline.collision import CollisionChecker, carried_shape
 from laserpick.pipeline.grasping import GraspSet, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
@@ -46,8 +46,11 @@ APPROACH_PERIOD = 0.25
 APPROACH_MAX_STEPS = 240
 #: Beyond this x (m, `base`) the hand is over the workspace in front of the scooter.
 WORKSPACE_X = 1.25
-#: TCP heights (m) over the basket's rim to release at.
-DROP_HEIGHTS = (0.06, 0.10, 0.14)
+#: TCP heights (m) over the basket's rim to release at: the low ones for most objects, the
+#: high ones for a tall object held near its top, which hangs deep below the hand.
+DROP_HEIGHTS = (0.06, 0.10, 0.14, 0.20, 0.26)
+#: Falls (m) that differ by less than this rank alike when choosing a drop posture.
+FALL_STEP = 0.04
 #: Highest extra lift (m) to bring a held object clear before carrying it.
 RISE_MAX = 0.20
 #: Points this close (m) to a held object's points are taken to be the object itself.
@@ -77,8 +80,9 @@ class Outcome:
 @dataclass
 class Held:
     """What the hand holds after a pick: the grasp, its height above the support surface (m)
-    (for placing, 004 section 7.3), the object's points in the TCP frame (m, thinned: the
-    planner carries them with the hand) and the obstacles around it."""
+    (for placing, 004 section 7.3), the object's points in the TCP frame (m, thinned, its
+    unseen back filled in by `carried_shape`: the planner carries them with the hand) and the
+    obstacles around it."""
 
     grasp: Grasp
     height_above_support: float
@@ -243,7 +247,7 @@ class Behaviours:
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
         support = grasps.target[:, 2].min()
-        pts = grasps.target[thin(grasps.target, 0.02)]
+        pts = carried_shape(grasps.target)
         pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
         self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
@@ -294,7 +298,8 @@ class Behaviours:
         gripper pointing down or tilted up to 30 deg, its TCP at one of DROP_HEIGHTS.
 
         Postures that hold every point of the object inside the opening (1 cm in from the
-        walls) come first, then those that hold its middle there; then the nearest to q_ref.
+        walls) come first, then those that hold its middle there; then the shortest fall
+        (in FALL_STEP steps: a long fall bounces the object out); then the nearest to q_ref.
         None when no clear posture holds even the middle over the opening: an object let go
         there would fall beside the basket, onto the scooter or the floor.
         The basket sits close beside the arm's base, between the tiller, the sensor posts and
@@ -302,7 +307,8 @@ class Behaviours:
         """
         lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
         hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
-        best: tuple[tuple[int, float], np.ndarray] | None = None
+        floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+        best: tuple[tuple[int, int, float], np.ndarray] | None = None
         candidates = np.array(drop_candidates())
         clear = checker.clearance_ok(candidates, payload=payload)
         T = tcp_pose(candidates[clear])
@@ -313,7 +319,8 @@ class Behaviours:
             inside = 0 if np.all((xy >= lo) & (xy <= hi)) else 1
             if inside and not np.all((middle >= lo) & (middle <= hi)):
                 continue
-            key = (inside, float(np.max(np.abs(q - q_ref))))
+            fall = int((pts[:, 2].min() - floor) // FALL_STEP)
+            key = (inside, fall, float(np.max(np.abs(q - q_ref))))
             if best is None or key < best[0]:
                 best = (key, q)
         return None if best is None else best[1]
@@ -361,6 +368,10 @@ class Behaviours:
         )
         if not out.ok:
             return out
+        if not self.robot.gripper_state().holding:
+            self.held = None
+            msg = "The object fell from the hand while it was carried to the basket."
+            return Outcome(Failure("execute", msg))
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
@@ -395,6 +406,10 @@ class Behaviours:
         out = self.go_to(q_above, checker, "carrying to the place", payload=held.points_tcp)
         if not out.ok:
             return out
+        if not self.robot.gripper_state().holding:
+            self.held = None
+            msg = "The object fell from the hand while it was carried to the place."
+            return Outcome(Failure("execute", msg))
         lowering = timed(down, s, tcp_speed=s.approach_speed)
         guarded = Trajectory(lowering.times, lowering.q, guard_force=s.guard_force)
         failure = self._run(guarded, "lowering the object")

@@ -15,6 +15,7 @@ from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
+    carried_shape,
     self_filter,
     sphere_centres,
     thin,
@@ -97,6 +98,30 @@ def test_thin_keeps_one_point_per_voxel():
     cells = np.floor(pts.astype(np.float32) / np.float32(0.05)).astype(int)
     assert keep.sum() == len(np.unique(cells, axis=0))
     assert len(np.unique(cells[keep], axis=0)) == keep.sum()
+
+
+def test_carried_shape_fills_in_the_unseen_back_of_a_can():
+    """A can seen from the front (-x) only: its front half-shell and its whole top. The
+    carried shape must reach the back of the can, 3.3 cm behind its axis, as the real can does."""
+    axis, r, h = np.array([1.5, -0.2]), 0.033, 0.12
+    t = np.linspace(np.pi / 2, 3 * np.pi / 2, 40)  # the half facing the cameras (-x)
+    z = np.linspace(0.46, 0.46 + h, 25)
+    tt, zz = np.meshgrid(t, z)
+    shell = np.c_[axis[0] + r * np.cos(tt.ravel()), axis[1] + r * np.sin(tt.ravel()), zz.ravel()]
+    rho, phi = np.meshgrid(np.linspace(0, r, 6), np.linspace(0, 2 * np.pi, 30))
+    top = np.c_[
+        axis[0] + (rho * np.cos(phi)).ravel(),
+        axis[1] + (rho * np.sin(phi)).ravel(),
+        np.full(rho.size, 0.46 + h),
+    ]
+    seen = np.vstack([shell, top])
+    assert seen[:, 0].max() == pytest.approx(axis[0] + r, abs=1e-3)  # only the top reaches back
+    carried = carried_shape(seen)
+    low = carried[carried[:, 2] < 0.5]  # below the top, where the seen shell is half a can
+    assert low[:, 0].max() > axis[0] + 0.8 * r
+    assert low[:, 0].min() < axis[0] - 0.8 * r
+    assert len(carried) < len(seen)  # thinned to one point per 2 cm voxel
+    assert len(carried_shape(np.zeros((0, 3)))) == 0
 
 
 def test_self_filter_removes_the_arm_and_keeps_the_rest():

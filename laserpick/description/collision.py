@@ -72,6 +72,7 @@ def _keepout() -> tuple[Box, ...]:
     half_w = dims.SCOOTER_WIDTH / 2
     w = dims.BASKET_WALL + 0.005
     bx0, by0, bz0 = dims.BASKET_CENTER - dims.BASKET_INNER / 2 - w
+    bz0 -= dims.BASKET_FLOOR_THICKNESS
     bx1, by1, bz1 = dims.BASKET_CENTER + dims.BASKET_INNER / 2 + w
     post_x = dims.SENSOR_X - 0.1
     post_y = dims.SENSOR_GROUP_SPACING / 2

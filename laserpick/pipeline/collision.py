@@ -78,6 +78,10 @@ _SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + UR5_D[0]])
 SELF_PADDING = 0.02
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
 PAYLOAD_POINT_RADIUS = 0.01
+#: Voxel (m) a carried object's points are thinned to, and the band (m) under its highest
+#: point taken as its top.
+CARRIED_VOXEL = 0.02
+CARRIED_TOP_BAND = 0.02
 #: A held object is checked against the arm's bodies up to this one (3: wrist 1).
 PAYLOAD_CLEAR_OF_BODY = 3
 
@@ -87,6 +91,29 @@ def thin(points: np.ndarray, voxel: float) -> np.ndarray:
     keep = np.zeros(len(points), bool)
     keep[voxel_first(points, voxel)] = True
     return keep
+
+
+def carried_shape(target: np.ndarray, voxel: float = CARRIED_VOXEL) -> np.ndarray:
+    """The points (m, `base`) that stand for an object the hand is about to carry: what the
+    cameras saw of it, and that mirrored through the vertical axis of its top.
+
+    The cameras see an object from the front and above only, so its back half is missing
+    from `target` (N, 3); a carry planned around the seen half alone swung a mug's unseen
+    back into the arm's forearm. Mirroring fills in the back of a box or a cylinder, and
+    over-covers other shapes, which only makes the planner more careful. The axis is the
+    middle of the top band's extent (the top is seen whole from above; the band's mean would
+    lean toward the cameras, where the seen sides add points). Thinned to one point per
+    `voxel` (m).
+    """
+    target = np.asarray(target, float).reshape(-1, 3)
+    if len(target) == 0:
+        return target
+    top = target[target[:, 2] > target[:, 2].max() - CARRIED_TOP_BAND]
+    mirrored = target.copy()
+    middle = (top[:, :2].min(axis=0) + top[:, :2].max(axis=0)) / 2  # not the mean: see above
+    mirrored[:, :2] = 2.0 * middle - target[:, :2]
+    both = np.vstack([target, mirrored])
+    return both[thin(both, voxel)]
 
 
 def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.ndarray:

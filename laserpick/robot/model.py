@@ -377,8 +377,8 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
         body,
         "basket_floor",
         G.mjGEOM_BOX,
-        (hx + w, hy + w, w / 2),
-        c + np.array([0.0, 0.0, -hz]),
+        (hx + w, hy + w, dims.BASKET_FLOOR_THICKNESS / 2),
+        c + np.array([0.0, 0.0, -hz - dims.BASKET_FLOOR_THICKNESS / 2]),
         basket_rgba,
     )
     for name, pos, size in (
