@@ -52,7 +52,8 @@ class Attempt:
     task: int = 0  #: which task of the trial: the tries at one object share it
     marks: int = 0  #: marks made (re-marks after a missed dot count)
     detected: bool = False  #: the grasp chosen (or executed) was on the marked object
-    grasped: bool = False  #: the marked object was lifted and held
+    #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)
+    grasped: bool = False
     success: bool = False  #: the attempt's task was done (in the basket, or placed upright)
     failure: str | None = None  #: one of FAILURE_KINDS when it did not succeed
     message: str = ""
@@ -251,8 +252,10 @@ class ScriptedOperator:
             if rec.success:
                 self.referee.take_out(rec.instance)
             else:
-                rec.grasped = False  # 004 counts a grasp as successful once in the basket
                 rec.fail("execute", "the object did not land in the basket")
+        # 004 section 8.1 counts a grasp as successful once the object is in the basket: one
+        # lifted but dropped on the way, or kept because no way to the basket was found, is not.
+        rec.grasped = rec.success
         self.tidy()
         return rec
 

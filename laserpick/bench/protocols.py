@@ -28,6 +28,7 @@ are worked through in the protocol's way (for selection, each trial marks one ra
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -46,7 +47,14 @@ from laserpick.bench.truth import Captured
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.types import Failure
 from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
-from laserpick.robot.scenes import Scene, Surface, load_scene, parse_scene, scene_config
+from laserpick.robot.scenes import (
+    Scene,
+    SceneError,
+    Surface,
+    load_scene,
+    parse_scene,
+    scene_config,
+)
 from laserpick.server.session import Selection, StrategyName, TaskState
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 
@@ -308,11 +316,26 @@ def _gone(op: ScriptedOperator, name: str) -> bool:
 
 
 def _coin_flip_kitchen(rng: np.random.Generator) -> Scene:
-    """The `kitchen` scene with each object upright or on its side by a coin flip."""
+    """The `kitchen` scene with each object upright or on its side by a coin flip. An object
+    that does not fit its spot on its side (a cereal box lying on a shelf's edge) stands
+    upright instead, as the experimenter would set it."""
     config = scene_config("kitchen")
-    for obj in config["objects"]:
+    objects = config["objects"]
+    for obj in objects:
         obj["lying"] = bool(rng.integers(2))
-    return parse_scene(yaml.safe_dump(config, sort_keys=False))
+    while True:
+        try:
+            return parse_scene(yaml.safe_dump(config, sort_keys=False))
+        except SceneError as e:
+            misfits = [int(m[1]) for path, _ in e.problems if (m := _OBJECT_PATH.match(path))]
+            lying = [i for i in misfits if objects[i]["lying"]]
+            if not lying:
+                raise
+            for i in lying:
+                objects[i]["lying"] = False
+
+
+_OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 
 
 def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray] | None:
