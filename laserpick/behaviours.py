@@ -246,8 +246,11 @@ class Behaviours:
             )
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
-        support = grasps.target[:, 2].min()
-        pts = carried_shape(grasps.target)
+        # The surface it stood on, as perceived; its lowest seen point when the surface is
+        # unknown or above it (an object seen only from above a table's edge).
+        lowest = float(grasps.target[:, 2].min())
+        support = lowest if grasps.support is None else min(grasps.support, lowest)
+        pts = carried_shape(grasps.target, support)
         pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
         self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.

@@ -18,16 +18,16 @@ from laserpick.bench.protocols import (
     JEEVES_MODELS,
     PROTOCOLS,
     Options,
-    _coin_flip_kitchen,
+    coin_flip_kitchen,
     jeeves_scene,
     scan_points,
 )
-from laserpick.robot.scenes import scene_config
 from laserpick.bench.report import markdown
 from laserpick.bench.results import outcomes, summarize
 from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
+from laserpick.robot.scenes import scene_config
 
 DATA = Path(__file__).parent / "data"
 
@@ -48,7 +48,7 @@ def test_every_coin_flipped_kitchen_builds() -> None:
     spot lying (seeds 2 and 3 put a cereal box past a shelf's edge), it stands instead."""
     flipped = 0
     for seed in range(1, 21):
-        scene = _coin_flip_kitchen(np.random.default_rng(seed))
+        scene = coin_flip_kitchen(np.random.default_rng(seed))
         assert len(scene.placements) == len(scene_config("kitchen")["objects"])
         flipped += sum(p.lying for p in scene.placements)
     assert 0 < flipped < 20 * len(scene.placements)  # both sides of the coin come up

@@ -122,6 +122,12 @@ def test_carried_shape_fills_in_the_unseen_back_of_a_can():
     assert low[:, 0].min() < axis[0] - 0.8 * r
     assert len(carried) < len(seen)  # thinned to one point per 2 cm voxel
     assert len(carried_shape(np.zeros((0, 3)))) == 0
+    # Seen only above a table's edge: the top 4 cm. Filled down to the table at 0.46 m.
+    upper = seen[seen[:, 2] > 0.46 + h - 0.04]
+    assert carried_shape(upper)[:, 2].min() > 0.53
+    filled = carried_shape(upper, support=0.46)
+    assert filled[:, 2].min() < 0.46 + 0.02
+    assert np.all(np.abs(filled[:, :2] - axis).max(axis=1) < r + 0.03)  # within the footprint
 
 
 def test_self_filter_removes_the_arm_and_keeps_the_rest():

@@ -315,7 +315,7 @@ def _gone(op: ScriptedOperator, name: str) -> bool:
     return bool(op.referee.world_position(name)[2] < 0.02)
 
 
-def _coin_flip_kitchen(rng: np.random.Generator) -> Scene:
+def coin_flip_kitchen(rng: np.random.Generator) -> Scene:
     """The `kitchen` scene with each object upright or on its side by a coin flip. An object
     that does not fit its spot on its side (a cereal box lying on a shelf's edge) stands
     upright instead, as the experimenter would set it."""
@@ -354,7 +354,7 @@ def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray
 
 def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     rng = np.random.default_rng(seed)
-    scene = _scene("", seed, opt) if opt.scene else _coin_flip_kitchen(rng)
+    scene = _scene("", seed, opt) if opt.scene else coin_flip_kitchen(rng)
     out = []
     with _operated(scene, trial, seed, opt) as op:
         for name in _limit(_shuffled(op, _instances(scene)), opt):

@@ -93,26 +93,41 @@ def thin(points: np.ndarray, voxel: float) -> np.ndarray:
     return keep
 
 
-def carried_shape(target: np.ndarray, voxel: float = CARRIED_VOXEL) -> np.ndarray:
+def carried_shape(
+    target: np.ndarray, support: float | None = None, voxel: float = CARRIED_VOXEL
+) -> np.ndarray:
     """The points (m, `base`) that stand for an object the hand is about to carry: what the
-    cameras saw of it, and that mirrored through the vertical axis of its top.
+    cameras saw of it, mirrored through the vertical axis of its top, and reaching down to
+    the surface it stands on.
 
-    The cameras see an object from the front and above only, so its back half is missing
-    from `target` (N, 3); a carry planned around the seen half alone swung a mug's unseen
-    back into the arm's forearm. Mirroring fills in the back of a box or a cylinder, and
-    over-covers other shapes, which only makes the planner more careful. The axis is the
-    middle of the top band's extent (the top is seen whole from above; the band's mean would
-    lean toward the cameras, where the seen sides add points). Thinned to one point per
-    `voxel` (m).
+    The cameras see an object from the front and above only, so its back half, and near a
+    table's edge its lower part, are missing from `target` (N, 3); a carry planned around
+    the seen part alone swung a mug's unseen back into the forearm, and a soda can's unseen
+    lower half into the upper arm. Mirroring fills in the back of a box or a cylinder; each
+    `voxel` (m) column of the footprint is filled down to `support` (m, the surface's height;
+    None: no filling), since the object stands on it. Other shapes are over-covered, which
+    only makes the planner more careful. The axis is the middle of the top band's extent (the
+    top is seen whole from above; the band's mean would lean toward the cameras, where the
+    seen sides add points). Thinned to one point per `voxel`.
     """
     target = np.asarray(target, float).reshape(-1, 3)
     if len(target) == 0:
         return target
     top = target[target[:, 2] > target[:, 2].max() - CARRIED_TOP_BAND]
+    middle = (top[:, :2].min(axis=0) + top[:, :2].max(axis=0)) / 2
     mirrored = target.copy()
-    middle = (top[:, :2].min(axis=0) + top[:, :2].max(axis=0)) / 2  # not the mean: see above
     mirrored[:, :2] = 2.0 * middle - target[:, :2]
     both = np.vstack([target, mirrored])
+    if support is not None:
+        columns, which = np.unique(np.floor(both[:, :2] / voxel), axis=0, return_inverse=True)
+        low = np.full(len(columns), np.inf)
+        np.minimum.at(low, which.ravel(), both[:, 2])
+        fill = [
+            np.c_[np.tile((c + 0.5) * voxel, (len(z), 1)), z]
+            for c, bottom in zip(columns, low, strict=True)
+            if len(z := np.arange(support + voxel / 2, bottom, voxel))
+        ]
+        both = np.vstack([both, *fill])
     return both[thin(both, voxel)]
 
 

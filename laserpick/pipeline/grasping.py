@@ -57,6 +57,8 @@ class GraspSet:
     target: np.ndarray
     strategy: Strategy
     timings: dict[str, float] = field(default_factory=dict)
+    #: Height (m, `base`) of the surface the target stands on; None when none was found.
+    support: float | None = None
 
     def ordered(self) -> list[Grasp]:
         """Every reachable grasp, best cluster first and best first within each (004's order
@@ -178,7 +180,8 @@ def find_grasps(
     scored = [score(g, q_now=q_ref, sample=target, mark=mark, settings=s.grasp) for g in ok]
     clusters = group(scored, s.grasp)
     timings["select"] = time.perf_counter() - t0
-    return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings)
+    support = seg.surface.height if seg.surface is not None else None
+    return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings, support)
 
 
 def plan_first(
