@@ -72,7 +72,6 @@ def _keepout() -> tuple[Box, ...]:
     half_w = dims.SCOOTER_WIDTH / 2
     w = dims.BASKET_WALL + 0.005
     bx0, by0, bz0 = dims.BASKET_CENTER - dims.BASKET_INNER / 2 - w
-    bz0 -= dims.BASKET_FLOOR_THICKNESS
     bx1, by1, bz1 = dims.BASKET_CENTER + dims.BASKET_INNER / 2 + w
     post_x = dims.SENSOR_X - 0.1
     post_y = dims.SENSOR_GROUP_SPACING / 2
@@ -92,7 +91,11 @@ def _keepout() -> tuple[Box, ...]:
             (dims.TILLER_X + 0.09, dims.HANDLEBAR_WIDTH / 2 + 0.03, dims.HANDLEBAR_HEIGHT + 0.04),
         ),
         # The basket: its floor and four walls, open at the top for a drop.
-        Box("basket_floor", (bx0, by0, bz0), (bx1, by1, bz0 + w)),
+        Box(
+            "basket_floor",
+            (bx0, by0, bz0 - dims.BASKET_FLOOR_THICKNESS),
+            (bx1, by1, bz0 + w),
+        ),
         Box("basket_front", (bx1 - w, by0, bz0), (bx1, by1, bz1)),
         Box("basket_back", (bx0, by0, bz0), (bx0 + w, by1, bz1)),
         Box("basket_left", (bx0, by1 - w, bz0), (bx1, by1, bz1)),

@@ -103,7 +103,7 @@ BASKET_INNER = np.array([0.20, 0.32, 0.16])
 BASKET_WALL = 0.008
 #: m. The basket's floor is thicker than its walls: a thin, light object let go above it
 #: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and a floor as thin as the
-#: walls let it pass its middle in one step and fall through. The top face stays where it is.
+#: walls let it pass its middle in one step and fall through. Its top is at the walls' foot.
 BASKET_FLOOR_THICKNESS = 0.03
 SCOOTER_MASS = 110.0
 
