@@ -38,11 +38,6 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 
 #: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
 _CHUNK_STEPS = 10
-#: A trajectory is done once its time is up and every joint is within SETTLE_TOL (rad) of
-#: its last point, or SETTLE_MAX (s) after its time is up: the servos lag their setpoint, and
-#: a next trajectory must start where this one ended (`execute` allows 0.05 rad).
-SETTLE_TOL = 0.01
-SETTLE_MAX = 1.0
 
 
 class MotionHandle:
@@ -394,10 +389,7 @@ class Simulation:
                         self._halt("failed", f"unexpected contact: {force:.0f} N on the arm")
                         return
                     if motion.finished(d.time):
-                        lag = np.max(np.abs(d.qpos[info.arm_qpos] - motion.traj.q[-1]))
-                        late = d.time - motion.t_start - motion.traj.duration
-                        if lag < SETTLE_TOL or late >= SETTLE_MAX:
-                            self._end_motion("done")
+                        self._end_motion("done")
                 else:
                     q = d.qpos[info.arm_qpos].copy()
                     self._q_set = motion.step(self._q_set, dt)
