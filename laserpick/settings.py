@@ -486,9 +486,6 @@ class MotionSettings(BaseModel):
         description="Failed joint-space searches in one pick before no more grasps are tried:"
         " each takes seconds, and a user should not wait minutes for a 'no'. Ours.",
     )
-    drop_height: float = Field(
-        0.16, gt=0, description="TCP height (m) above the basket's rim when releasing."
-    )
     place_clearance: float = Field(
         0.01, ge=0, description="Height (m) above the computed resting pose to release at."
     )
