@@ -348,6 +348,15 @@ class Behaviours:
             risen += 0.05
         return None
 
+    def _lost_on_the_way(self, where: str) -> Outcome | None:
+        """After a carry to `where`: the failure to end with if the hand no longer holds the
+        object (it fell on the way), else None."""
+        if self.robot.gripper_state().holding:
+            return None
+        self.held = None
+        msg = f"The object fell from the hand while it was carried to {where}."
+        return Outcome(Failure("execute", msg))
+
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready."""
         if self.held is None or not self.robot.gripper_state().holding:
@@ -371,10 +380,9 @@ class Behaviours:
         )
         if not out.ok:
             return out
-        if not self.robot.gripper_state().holding:
-            self.held = None
-            msg = "The object fell from the hand while it was carried to the basket."
-            return Outcome(Failure("execute", msg))
+        lost = self._lost_on_the_way("the basket")
+        if lost is not None:
+            return lost
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
@@ -409,10 +417,9 @@ class Behaviours:
         out = self.go_to(q_above, checker, "carrying to the place", payload=held.points_tcp)
         if not out.ok:
             return out
-        if not self.robot.gripper_state().holding:
-            self.held = None
-            msg = "The object fell from the hand while it was carried to the place."
-            return Outcome(Failure("execute", msg))
+        lost = self._lost_on_the_way("the place")
+        if lost is not None:
+            return lost
         lowering = timed(down, s, tcp_speed=s.approach_speed)
         guarded = Trajectory(lowering.times, lowering.q, guard_force=s.guard_force)
         failure = self._run(guarded, "lowering the object")
