@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import requests
 import yaml
-from basket import judge_drop
+from basket import judge_drop, lost_in_carry
 from serve_process import ServeProcess
 from websockets.sync.client import connect
 
@@ -112,8 +112,9 @@ def test_pick_and_drop_on_isolation(client: Client) -> None:
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     client.post("/execute")
     state = client.settled(180)
-    assert state["state"] == "idle" and state["failure"] is None, state["message"]
-    judge_drop(obj(client, "mug_1"))
+    lost = lost_in_carry(state["failure"])
+    assert state["state"] == "idle" and (state["failure"] is None or lost), state["message"]
+    judge_drop(obj(client, "mug_1"), lost)
     names = [e["name"] for e in client.events]
     assert "job" in names and "progress" in names
     assert client.frames > 100  # the 30 Hz stream kept coming during the task
