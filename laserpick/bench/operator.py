@@ -10,6 +10,7 @@ it only to look at the world the way a person would.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -30,6 +31,27 @@ TREMOR_STD = math.radians(0.3)
 #: m behind a surface's front edge that the user parks to work at (the isolation table's
 #: objects stand 5-45 cm behind its edge at 1.30 m).
 PARK_SPOT_DEPTH = 0.25
+#: m from the rear axle to the front edge of the surface the user parks at: close to a low
+#: surface, for the arm to reach over it; farther from one above the arm's shoulder, which
+#: the upper arm must rise past before it can reach forward (at 1.30 m the 73 cm table's
+#: edge stands 16 cm before the mount, and no path led from the stowed arm to the ready pose).
+PARK_EDGE = 1.30
+PARK_EDGE_HIGH = 1.40
+#: m the scripted user keeps every part of the scooter, arm and held object included, from
+#: the furniture when driving between surfaces. The simulated scooter pushes furniture aside
+#: and sweeps objects off it; a careful user does neither.
+DRIVE_MARGIN = 0.03
+#: m, the spacing of the grid of points where the user might stop on the way to turn.
+VIA_SPACING = 0.2
+#: m the user backs out from a surface before turning, beyond what they were asked: the
+#: first that leaves room.
+REVERSE_STEPS = (0.0, 0.4, 0.8)
+#: m before the parking spot where the user turns to face it and creeps in: the first that
+#: leaves room.
+APPROACH_DISTANCES = (0.8, 1.2)
+#: rad. Off its heading by more than this, the user stops and turns on the spot: driving
+#: while turning hard swings the front wide.
+GO_ALIGNED = math.radians(20.0)
 
 
 @dataclass
@@ -165,6 +187,26 @@ class Referee:
         hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
         return bool(np.all(p >= lo - [0.0, 0.0, 0.02]) and np.all(p <= hi + [0.0, 0.0, 0.05]))
 
+    def outline(self) -> Outline:
+        """The scooter's footprint with the arm as it stands now, and what it holds (m,
+        `base`): the bounds of the geoms of the scooter's body tree and of a held object."""
+        m, d = self.robot.model, self._posed()
+        bodies = self.robot.sim.info.object_bodies
+        scooter = m.body("scooter").id
+        held = {bodies[name] for name in bodies if self.near_hand(name)}
+        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+        corners = []
+        for g in range(m.ngeom):
+            body = m.geom_bodyid[g]
+            if m.body_rootid[body] != scooter and body not in held:
+                continue
+            local = m.geom_aabb[g, :3] + signs * m.geom_aabb[g, 3:]
+            corners.append(local @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g])
+        world = np.vstack(corners)
+        base = (self._T_base_world() @ np.c_[world, np.ones(len(world))].T).T
+        lo, hi = base[:, :2].min(axis=0), base[:, :2].max(axis=0)
+        return Outline((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
+
     def aim_point(self, instance: str) -> np.ndarray | None:
         """Where a person would aim: the middle of the object's visible top (m, `base`), from
         the cameras' view labelled by the simulator; None if no camera sees it."""
@@ -184,10 +226,13 @@ def scene_config_backed(name: str, back: float) -> dict:
     return config
 
 
-def parking_pose(surface: Surface, local_y: float = 0.0) -> np.ndarray:
-    """Where the user parks to work on `surface`: facing it, its front edge 1.30 m ahead of
-    the rear axle and the spot `local_y` (m, the surface's frame) in front of the arm.
-    Returns (x, y, yaw) in `world` (m, rad)."""
+def parking_pose(surface: Surface, local_y: float = 0.0, level: float | None = None) -> np.ndarray:
+    """Where the user parks to work on `surface` at height `level` (m; default its lowest
+    level): facing it, its front edge PARK_EDGE ahead of the rear axle (PARK_EDGE_HIGH when
+    the level is above the arm's shoulder) and the spot `local_y` (m, the surface's frame)
+    in front of the arm. Returns (x, y, yaw) in `world` (m, rad)."""
+    level = surface.levels[0] if level is None else level
+    edge = PARK_EDGE_HIGH if level > dims.ARM_MOUNT_POS[2] + dims.UR5_D[0] else PARK_EDGE
     yaw = surface.yaw  # the front faces the surface's local -x: face its +x
     c, s = math.cos(yaw), math.sin(yaw)
     front_x = -surface.size[0] / 2
@@ -195,7 +240,7 @@ def parking_pose(surface: Surface, local_y: float = 0.0) -> np.ndarray:
     spot = np.asarray(surface.xy) + np.array(
         [c * spot_local[0] - s * spot_local[1], s * spot_local[0] + c * spot_local[1]]
     )
-    reach = np.array([1.30 + PARK_SPOT_DEPTH, dims.ARM_MOUNT_POS[1]])
+    reach = np.array([edge + PARK_SPOT_DEPTH, dims.ARM_MOUNT_POS[1]])
     origin = spot - np.array([c * reach[0] - s * reach[1], s * reach[0] + c * reach[1]])
     return np.array([origin[0], origin[1], yaw])
 
@@ -209,16 +254,59 @@ class Driver(Protocol):
     def drive(self, v: float, w: float) -> None: ...
 
 
-def drive_to(driver: Driver, goal: np.ndarray, *, reverse_first: float = 0.0) -> bool:
-    """Drive like a careful user: back out `reverse_first` m, turn toward a point 0.8 m in
-    front of the goal, drive there, turn to face the goal and creep in. Returns whether the
-    scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`)."""
+@dataclass(frozen=True)
+class Outline:
+    """The scooter's footprint with the arm as it stands: a rectangle in `base` (m), x from
+    the rear edge to the front (the arm's reach included), y from right to left."""
+
+    x: tuple[float, float]
+    y: tuple[float, float]
+
+    def points(self, step: float = 0.05) -> np.ndarray:
+        """Points along the rectangle's edges (m, `base` xy), at most `step` apart."""
+        (x0, x1), (y0, y1) = self.x, self.y
+        nx, ny = int(np.ceil((x1 - x0) / step)) + 1, int(np.ceil((y1 - y0) / step)) + 1
+        xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+        return np.vstack(
+            [
+                np.c_[xs, np.full(nx, y0)],
+                np.c_[xs, np.full(nx, y1)],
+                np.c_[np.full(ny, x0), ys],
+                np.c_[np.full(ny, x1), ys],
+            ]
+        )
+
+
+def drive_to(
+    driver: Driver,
+    goal: np.ndarray,
+    *,
+    reverse_first: float = 0.0,
+    around: Sequence[Surface] = (),
+    outline: Outline | None = None,
+) -> bool:
+    """Drive like a careful user: back out `reverse_first` m, drive to a point 0.8 m in
+    front of the goal, turn to face the goal and creep in. Returns whether the scooter ended
+    within 3 cm and 2 deg of `goal` (x, y, yaw in `world`).
+
+    Given the furniture (`around`) and the scooter's `outline`, the user first looks for a
+    way that keeps the whole scooter DRIVE_MARGIN from the furniture (`plan_drive`): backing
+    out farther, turning farther out, or stopping on the way to turn, where needed. Finding
+    none, they do not drive, and it returns False."""
     goal = np.asarray(goal, float)
-    approach = goal[:2] - 0.8 * np.array([math.cos(goal[2]), math.sin(goal[2])])
+    waypoints = [
+        goal[:2] - APPROACH_DISTANCES[0] * np.array([math.cos(goal[2]), math.sin(goal[2])])
+    ]
+    if around and outline is not None:
+        plan = plan_drive(driver.base_pose(), goal, around, outline, reverse_first)
+        if plan is None:
+            return False
+        reverse_first, waypoints = plan
     if reverse_first > 0:
         start = driver.base_pose()[:2].copy()
         _drive_loop(driver, lambda p: (-0.3, 0.0, np.linalg.norm(p[:2] - start) >= reverse_first))
-    _go_point(driver, approach)
+    for waypoint in waypoints:
+        _go_point(driver, waypoint)
     _turn_to(driver, goal[2])
     _go_point(driver, goal[:2], speed=0.2)
     _turn_to(driver, goal[2])
@@ -264,7 +352,114 @@ def _go_point(driver: Driver, xy: np.ndarray, speed: float = 0.5) -> None:
         d = xy - p[:2]
         dist = float(np.linalg.norm(d))
         err = _wrap(math.atan2(d[1], d[0]) - p[2])
-        v = min(speed, 0.8 * dist) * max(0.0, math.cos(err))
-        return v, float(np.clip(1.5 * err, -0.6, 0.6)) if dist > 0.05 else 0.0, dist < 0.01
+        if dist < 0.01 or (dist < 0.05 and abs(err) > math.pi / 2):  # there, or just past
+            return 0.0, 0.0, True
+        w = float(np.clip(1.5 * err, -0.6, 0.6)) if dist > 0.05 else 0.0
+        if abs(err) > GO_ALIGNED:
+            return 0.0, w, False
+        return min(speed, 0.8 * dist) * math.cos(err), w, False
 
     _drive_loop(driver, cmd)
+
+
+def _clearance(surfaces: Sequence[Surface], xy: np.ndarray) -> np.ndarray:
+    """Distance (m) from each of the points `xy` (N x 2, `world`) to the nearest of the
+    surfaces' footprints; inf without surfaces."""
+    out = np.full(len(xy), np.inf)
+    for s in surfaces:
+        c, si = math.cos(s.yaw), math.sin(s.yaw)
+        d = xy - np.asarray(s.xy)
+        local = np.c_[c * d[:, 0] + si * d[:, 1], -si * d[:, 0] + c * d[:, 1]]
+        outside = np.maximum(np.abs(local) - np.asarray(s.size) / 2, 0.0)
+        out = np.minimum(out, np.linalg.norm(outside, axis=1))
+    return out
+
+
+def _at(poses: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """The `base` points `local` (M x 2) at each of the poses (K x 3: x, y, yaw in `world`),
+    as one (K * M) x 2 array in `world`."""
+    c, si = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    x = poses[:, :1] + c * local[:, 0] - si * local[:, 1]
+    y = poses[:, 1:2] + si * local[:, 0] + c * local[:, 1]
+    return np.c_[x.ravel(), y.ravel()]
+
+
+def _leg(a: np.ndarray, b: np.ndarray, yaw: float, step: float = 0.05) -> np.ndarray:
+    """Poses (K x 3) along the straight line from a to b (m, `world` xy) at heading yaw."""
+    n = max(2, int(np.linalg.norm(b - a) / step) + 1)
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    return np.c_[a + t * (b - a), np.full(n, yaw)]
+
+
+def _turn(xy: np.ndarray, yaw0: float, yaw1: float, step: float = math.radians(5)) -> np.ndarray:
+    """Poses (K x 3) of a turn on the spot at xy from yaw0 to yaw1, the short way round."""
+    turn = _wrap(yaw1 - yaw0)
+    n = max(2, int(abs(turn) / step) + 1)
+    return np.c_[np.tile(xy, (n, 1)), yaw0 + np.linspace(0.0, turn, n)]
+
+
+def _heading(a: np.ndarray, b: np.ndarray) -> float:
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def plan_drive(
+    start: np.ndarray,
+    goal: np.ndarray,
+    surfaces: Sequence[Surface],
+    outline: Outline,
+    reverse_first: float = 0.0,
+) -> tuple[float, list[np.ndarray]] | None:
+    """A way from `start` to park at `goal` (x, y, yaw in `world`) that keeps the whole
+    scooter DRIVE_MARGIN from every surface, driven as `drive_to` drives: back out, turn on
+    the spot toward the next point and drive there, ..., turn to the goal's heading before
+    it and creep in. Returns (how far to back out (m), the points to drive through (m,
+    `world` xy), the last one APPROACH_DISTANCES before the goal), or None.
+
+    Tried in order: backing out `reverse_first` plus each of REVERSE_STEPS; each approach
+    distance; straight, then through one point of a VIA_SPACING grid, nearest first. The
+    moves that leave the start and that reach the goal may touch the surfaces the scooter
+    touches there: it is parked at them."""
+    start, goal = np.asarray(start, float), np.asarray(goal, float)
+    local = outline.points()
+
+    def clear(poses: np.ndarray, exempt: frozenset[str] = frozenset()) -> bool:
+        others = [s for s in surfaces if s.name not in exempt]
+        return bool(np.all(_clearance(others, _at(poses, local)) >= DRIVE_MARGIN))
+
+    def touching(pose: np.ndarray) -> frozenset[str]:
+        points = _at(pose[None], local)
+        return frozenset(s.name for s in surfaces if _clearance([s], points).min() < DRIVE_MARGIN)
+
+    at_start, at_goal = touching(start), touching(goal)
+    facing = np.array([math.cos(goal[2]), math.sin(goal[2])])
+
+    def arrive_clear(xy: np.ndarray, yaw: float, approach: np.ndarray) -> bool:
+        """From xy at yaw: turn toward the approach, drive there, turn and creep in."""
+        h = _heading(xy, approach)
+        return (
+            clear(np.vstack([_turn(xy, yaw, h), _leg(xy, approach, h)]))
+            and clear(_turn(approach, h, goal[2]), at_goal)
+            and clear(_leg(approach, goal[:2], goal[2]), at_goal)
+        )
+
+    lo = np.min([s.xy for s in surfaces], axis=0) - 1.0
+    hi = np.max([s.xy for s in surfaces], axis=0) + 1.0
+    grid = np.mgrid[lo[0] : hi[0] : VIA_SPACING, lo[1] : hi[1] : VIA_SPACING].reshape(2, -1).T
+    # The sweeps decide; this only drops points where the scooter could not even stand.
+    vias = grid[_clearance(surfaces, grid) >= 0.5 * (outline.y[1] - outline.y[0])]
+    for back in sorted({reverse_first + r for r in REVERSE_STEPS}):
+        out = start[:2] - back * np.array([math.cos(start[2]), math.sin(start[2])])
+        if back > 0 and not clear(_leg(start[:2], out, start[2]), at_start):
+            continue
+        leaving = at_start if back == 0 else frozenset()
+        for approach in (goal[:2] - d * facing for d in APPROACH_DISTANCES):
+            h = _heading(out, approach)
+            if clear(_turn(out, start[2], h), leaving) and arrive_clear(out, start[2], approach):
+                return back, [approach]
+            length = np.linalg.norm(vias - out, axis=1) + np.linalg.norm(vias - approach, axis=1)
+            for via in vias[np.argsort(length)]:
+                h = _heading(out, via)
+                leave = np.vstack([_turn(out, start[2], h), _leg(out, via, h)])
+                if clear(leave, leaving) and arrive_clear(via, h, approach):
+                    return back, [via, approach]
+    return None

@@ -288,10 +288,13 @@ def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str) -> bool:
     object before the arm. Returns whether it parked."""
     placement = scene.placement(instance)
     surface = scene.surface(placement.surface)
-    goal = parking_pose(surface, _local_y(surface, scene, instance))
+    level = surface.levels[placement.level]
+    goal = parking_pose(surface, _local_y(surface, scene, instance), level)
     if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
         return True
-    return drive_to(op, goal, reverse_first=0.6)
+    return drive_to(
+        op, goal, reverse_first=0.6, around=scene.surfaces, outline=op.referee.outline()
+    )
 
 
 def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
@@ -389,7 +392,9 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     if spot is None:
         return rec.fail("precondition", f"no free spot on {dest.name}")
     local_y, spot_world = spot
-    if not drive_to(op, parking_pose(dest, local_y), reverse_first=0.6):
+    parking = parking_pose(dest, local_y, spot_world[2])
+    outline = op.referee.outline()  # the object in hand included
+    if not drive_to(op, parking, reverse_first=0.6, around=scene.surfaces, outline=outline):
         return rec.fail("precondition", f"the user could not park at {dest.name}")
     spot_base = (invert(planar_pose(*op.base_pose())) @ np.append(spot_world, 1.0))[:3]
     placed = op.place(spot_base)
