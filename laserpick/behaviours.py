@@ -180,7 +180,8 @@ class Behaviours:
         return Outcome(self._run(timed(path, s, joint_speed=speed), what))
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
-        """To the ready pose, raised in front with the gripper down. Without a `checker`
+        """To the ready pose, raised in front with the gripper down, or to the high ready
+        pose where the checker's cloud fills the ready pose. Without a `checker`
         (no fresh cloud), a hand below the ready height first rises straight up to it, so
         that the move does not sweep it through what stands around it."""
         if checker is None:
@@ -196,6 +197,10 @@ class Behaviours:
                     failure = self._run(timed(up, self.settings.motion), "rising")
                     if failure is not None:
                         return Outcome(failure)
+        # Before a surface above the ready hand (the 87 cm counter), the high ready pose.
+        high = not checker.clearance_ok(dims.UR5_READY_Q)[0]
+        if high and checker.clearance_ok(dims.UR5_HIGH_READY_Q)[0]:
+            return self.go_to(dims.UR5_HIGH_READY_Q, checker, "going to ready")
         return self.go_to(dims.UR5_READY_Q, checker, "going to ready", via=(dims.UR5_HIGH_READY_Q,))
 
     def stow(self) -> Outcome:

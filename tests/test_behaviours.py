@@ -66,6 +66,18 @@ def test_guarded_trajectory_stops_on_contact(robot):
     assert tcp_z > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
 
 
+def test_before_a_counter_above_the_ready_hand_the_arm_goes_to_the_high_ready_pose(robot):
+    """A cloud with a counter top at 87 cm from 1.40 m on fills the ready pose's hand (TCP
+    at 85 cm): going to ready goes to the high ready pose instead of finding no way."""
+    xs, ys = np.meshgrid(np.arange(1.40, 1.90, 0.01), np.arange(-0.6, 0.2, 0.01))
+    top = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 0.87)]
+    checker = CollisionChecker(top)
+    assert not checker.clearance_ok(dims.UR5_READY_Q)[0]
+    b = Behaviours(robot)
+    assert b.go_ready(checker).ok
+    assert np.abs(robot.joint_state().q - dims.UR5_HIGH_READY_Q).max() < 0.05
+
+
 def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
     # The planner sees nothing (an empty cloud); the grasp is 4 cm into the table top.
     pose = np.eye(4)
