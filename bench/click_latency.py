@@ -65,7 +65,7 @@ def main() -> int:
     samples: list[float] = []
     server_share: list[float] = []  #: from the click's arrival in the server (ms)
     with tempfile.TemporaryDirectory() as tmp:
-        server = ServeProcess(Path(tmp), extra_args=("--no-shadows",)).start()
+        server = ServeProcess(Path(tmp), extra_args=("--lite-view",)).start()
         # The bench holds the operator station's lease; the 3D view's clicks act under it.
         api = Client(server.url, name="latency bench", source="console")
         try:

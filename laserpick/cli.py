@@ -108,10 +108,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     serve.add_argument("--viewer-rate", type=float, default=40.0, help="3D view updates (Hz)")
     serve.add_argument(
-        "--no-shadows",
-        dest="shadows",
-        action="store_false",
-        help="no shadows in the 3D view (for browsers without a GPU)",
+        "--lite-view",
+        action="store_true",
+        help="draw the 3D view for browsers without a GPU: no shadows or environment "
+        "lighting, flat shading (3x faster in software WebGL)",
     )
     serve.set_defaults(func=cmd_serve)
     _add_adapter_parser(sub)
@@ -341,7 +341,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
             server,
             rate_hz=args.viewer_rate,
             controls=False,
-            shadows=args.shadows,
+            lite=args.lite_view,
         )
         viewer.start()
         session.on_scene(lambda robot: viewer.set_simulation(robot.sim))

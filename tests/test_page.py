@@ -48,7 +48,7 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServeProcess]:
     if not Path(headless_chromium.CHROMIUM).exists():
         pytest.skip("no Chromium at /usr/bin/chromium")
     # No shadows: software WebGL draws twice as fast, leaving the CPU to the simulation.
-    proc = ServeProcess(tmp_path_factory.mktemp("page"), extra_args=("--no-shadows",))
+    proc = ServeProcess(tmp_path_factory.mktemp("page"), extra_args=("--lite-view",))
     try:
         proc.start()
         yield proc
