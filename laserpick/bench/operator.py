@@ -45,7 +45,7 @@ DRIVE_MARGIN = 0.03
 VIA_SPACING = 0.2
 #: m the user backs out from a surface before turning, beyond what they were asked: the
 #: first that leaves room.
-REVERSE_STEPS = (0.0, 0.4, 0.8)
+REVERSE_STEPS = (0.0, 0.4, 0.8, 1.2, 1.6)
 #: m before the parking spot where the user turns to face it and creeps in: the first that
 #: leaves room.
 APPROACH_DISTANCES = (0.8, 1.2)
