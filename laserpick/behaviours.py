@@ -362,6 +362,28 @@ class Behaviours:
         msg = f"The object fell from the hand while it was carried to {where}."
         return Outcome(Failure("execute", msg))
 
+    def tuck(self) -> Outcome:
+        """Hold what the hand holds folded back beside the scooter (`dims.UR5_CARRY_Q`) while
+        the user drives and marks where it goes: out of the cameras' view, the laser's way and
+        the furniture's (raised in front, the object hangs 1.6 m ahead of the rear axle, into
+        a shelf the scooter parks at). Where no way there is found, raised in front (the high
+        ready pose)."""
+        held = self.held
+        if held is None:
+            return Outcome(Failure("precondition", "The hand is not holding anything."))
+        out = self.go_to(
+            dims.UR5_CARRY_Q,
+            held.surroundings,
+            "tucking it in",
+            via=(dims.UR5_HIGH_READY_Q,),
+            payload=held.points_tcp,
+        )
+        if out.ok or out.failure is None or out.failure.kind != "ik_plan":
+            return out  # it went there, or a motion was stopped: no second one
+        return self.go_to(
+            dims.UR5_HIGH_READY_Q, held.surroundings, "raising", payload=held.points_tcp
+        )
+
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready."""
         if self.held is None or not self.robot.gripper_state().holding:
@@ -419,7 +441,13 @@ class Behaviours:
             return Outcome(found)
         q_above, down, T_above = found
         self.progress("Carrying the object to the place mark.")
-        out = self.go_to(q_above, checker, "carrying to the place", payload=held.points_tcp)
+        out = self.go_to(
+            q_above,
+            checker,
+            "carrying to the place",
+            via=(dims.UR5_HIGH_READY_Q,),
+            payload=held.points_tcp,
+        )
         if not out.ok:
             return out
         lost = self._lost_on_the_way("the place")
@@ -459,9 +487,10 @@ class Behaviours:
             ]
             T_above = T_place.copy()
             T_above[2, 3] += s.approach_distance
+            # Nearest the poses in front first, whether the object is tucked in or raised.
             clear = [
                 q
-                for q in ik_tcp(T_above, q_now)
+                for q in ik_tcp(T_above, dims.UR5_HIGH_READY_Q)
                 if checker.clearance_ok(q, payload=held.points_tcp)[0]
             ]
             reached = reached or bool(clear)

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from basket import judge_drop, lost_in_carry
 from serve_process import REPO, ServeProcess, stop_process
-from test_server import kitchen_at
+from test_server import kitchen_at, remote_goal
 
 from laserpick.adapters.announce import Announcer
 from laserpick.adapters.connection import MAX_NUDGE, Connection
@@ -327,7 +327,7 @@ def test_sip_and_puff_picks_and_places_on_kitchen(server: ServeProcess, tmp_path
     does by REST), by sips and puffs only: modes, aiming, confirming, going and placing."""
     state = prepare(server.url, scene={"yaml": kitchen_at("table_31")})
     remote = obj(server.url, "tv_remote")
-    goal = [0.45, 2.25, 0.31]  # world: on the coffee table, beside where it lay
+    goal = remote_goal()
     y1, p1 = aim_angles(remote["center_base"])
     y2, p2 = aim_angles(world_to_base(goal, state["base_pose"]))
     y0, p0 = state["laser"]["yaw"], state["laser"]["pitch"]

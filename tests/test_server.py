@@ -132,6 +132,12 @@ def kitchen_at(surface: str) -> str:
     return yaml.safe_dump(config)
 
 
+def remote_goal() -> list[float]:
+    """World (m): on the 31 cm coffee table, 20 cm along it from where the TV remote lies."""
+    remote = next(o for o in scene_config("kitchen")["objects"] if o["name"] == "tv_remote")
+    return [remote["xy"][0] + 0.2, remote["xy"][1], 0.31]
+
+
 def test_pick_and_place_on_kitchen(client: Client) -> None:
     """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it."""
     client.post("/scene", {"yaml": kitchen_at("table_31")})
@@ -141,7 +147,7 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
     state = client.settled(180)
     assert state["state"] == "awaiting_place", state["message"]
     assert state["gripper"]["holding"]
-    goal = [0.45, 2.25, 0.31]  # world: on the coffee table, beside where it lay
+    goal = remote_goal()
     client.post("/laser/aim", {"point": goal, "frame": "world"})
     client.post("/laser/confirm")
     state = client.settled(180)

@@ -44,6 +44,7 @@ from laserpick.bench.operator import (
 )
 from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
 from laserpick.bench.truth import Captured
+from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.types import Failure
 from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
@@ -346,14 +347,17 @@ _OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 
 
 def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray] | None:
-    """A spot on `surface` 25 cm behind its front edge and 15 cm from every object: (local y,
-    world xyz on the lowest level). None when the surface has no such spot."""
+    """A spot on the top of `surface`, 25 cm behind its front edge (half its depth if that is
+    less) and 15 cm from every object: (local y, world xyz). A shelf's top, not its lower
+    boards: under a board the cameras see no dot and no surface. None when the surface has
+    no such spot."""
     half_w = surface.size[1] / 2 - 0.15
     objects = [op.referee.world_position(n) for n in op.referee.instances()]
-    level = surface.levels[0]
+    level = surface.levels[-1]
+    depth = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
     for _ in range(100):
         ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
-        xy = surface.to_world(np.array([-surface.size[0] / 2 + PARK_SPOT_DEPTH, ly]))
+        xy = surface.to_world(np.array([-surface.size[0] / 2 + depth, ly]))
         if all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1):
             return ly, np.array([xy[0], xy[1], level])
     return None
@@ -382,11 +386,18 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
         return rec
     if session.state != TaskState.AWAITING_PLACE:
         return rec.fail("execute", f"the session is {session.state.value}, not awaiting a mark")
-    # Where the object sits relative to the TCP, as it will when set down (m, `base` xy: the
-    # place keeps the grasp's orientation in `base`).
-    offset = (referee.position(rec.instance) - tcp_pose(op.robot.joint_state().q)[:3, 3])[:2]
+    # Where the object sits relative to the TCP when it is set down (m, `base` xy): the hand
+    # holds it tucked in now, and the place turns the hand back to the grasp's orientation.
+    T_tcp = tcp_pose(op.robot.joint_state().q)
+    in_hand = T_tcp[:3, :3].T @ (referee.position(rec.instance) - T_tcp[:3, 3])
+    held = session.behaviours.held
+    assert held is not None  # awaiting a place mark: the session holds it
+    offset = (held.grasp.pose[:3, :3] @ in_hand)[:2]
     here = scene.placement(rec.instance).surface
-    dests = [s for s in scene.surfaces if s.name != here]
+    # The user marks the spot from the seat: a top above their hand (the 100 cm shelf top,
+    # the 108 cm table) shows them only its front edge.
+    markable = [s for s in scene.surfaces if s.levels[-1] < dims.LASER_ORIGIN[2] - 0.05]
+    dests = [s for s in markable if s.name != here]
     dest = dests[int(op.rng.integers(len(dests)))] if dests else scene.surface(here)
     spot = free_spot(op, dest)
     if spot is None:

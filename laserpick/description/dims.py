@@ -50,6 +50,12 @@ UR5_TORQUE_MAX = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
 #: Folded down and back along the scooter's right side, gripper down: out of the depth
 #: cameras' view of the workspace (only right_55 sees part of it) and clear of the basket (rad).
 UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
+#: Holding an object while the user drives and marks where it goes (pick and place): folded
+#: back along the scooter's right side, gripper down, the TCP at about (0.90, -0.65, 0.95) in
+#: `base`. The upper arm stays behind the sensor posts (x <= 1.10) and the whole arm within
+#: x <= 1.23 and y >= -0.71, and an object up to 25 cm long and 5 cm in radius hangs clear of
+#: the arm and the scooter (found by a search over the side, nearest the high ready pose).
+UR5_CARRY_Q = np.array([-2.432, -1.182, 0.68, 2.074, 1.571, 1.211])
 #: Raised in front, elbow up, gripper pointing down with the TCP at about (1.50, -0.30, 0.85)
 #: in `base`: the transit pose between home and any grasp above the workspace. Far enough
 #: forward that the elbow clears the right sensor housings by 3 cm (rad).

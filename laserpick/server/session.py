@@ -721,14 +721,10 @@ class Session:
         if self.mode == "pick_and_drop":
             self._drop_job()
             return
-        held = self.behaviours.held
-        assert held is not None
-        raised = self.behaviours.go_to(
-            dims.UR5_HIGH_READY_Q, held.surroundings, "raising", payload=held.points_tcp
-        )
-        if not raised.ok:
-            assert raised.failure is not None
-            self._end_badly(raised.failure)
+        tucked = self.behaviours.tuck()
+        if not tucked.ok:
+            assert tucked.failure is not None
+            self._end_badly(tucked.failure)
             return
         with self._lock:
             self._set(TaskState.AWAITING_PLACE, "Mark where to put it, then confirm.")
@@ -789,10 +785,8 @@ class Session:
         self._cancel.clear()  # the retreat itself must be allowed to move
         b = self.behaviours
         if b.held is not None and self.robot.gripper_state().holding:
-            self._progress("Raising what the hand holds.")
-            b.go_to(
-                dims.UR5_HIGH_READY_Q, b.held.surroundings, "raising", payload=b.held.points_tcp
-            )
+            self._progress("Tucking in what the hand holds.")
+            b.tuck()
         else:
             if self.robot.gripper_state().closed:
                 self.robot.gripper(False)
