@@ -286,8 +286,8 @@ def drive_to(
     outline: Outline | None = None,
 ) -> bool:
     """Drive like a careful user: back out `reverse_first` m, drive to a point 0.8 m in
-    front of the goal, turn to face the goal and creep in. Returns whether the scooter ended
-    within 3 cm and 2 deg of `goal` (x, y, yaw in `world`).
+    front of the goal (APPROACH_DISTANCES), turn to face the goal and creep in. Returns
+    whether the scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`).
 
     Given the furniture (`around`) and the scooter's `outline`, the user first looks for a
     way that keeps the whole scooter DRIVE_MARGIN from the furniture (`plan_drive`): backing
@@ -433,14 +433,15 @@ def plan_drive(
     at_start, at_goal = touching(start), touching(goal)
     facing = np.array([math.cos(goal[2]), math.sin(goal[2])])
 
-    def arrive_clear(xy: np.ndarray, yaw: float, approach: np.ndarray) -> bool:
-        """From xy at yaw: turn toward the approach, drive there, turn and creep in."""
-        h = _heading(xy, approach)
-        return (
-            clear(np.vstack([_turn(xy, yaw, h), _leg(xy, approach, h)]))
-            and clear(_turn(approach, h, goal[2]), at_goal)
-            and clear(_leg(approach, goal[:2], goal[2]), at_goal)
-        )
+    def go(xy: np.ndarray, yaw: float, to: np.ndarray) -> tuple[np.ndarray, float]:
+        """The poses of turning at xy from yaw toward `to` and driving there, and the heading."""
+        h = _heading(xy, to)
+        return np.vstack([_turn(xy, yaw, h), _leg(xy, to, h)]), h
+
+    def arrive_clear(approach: np.ndarray, yaw: float) -> bool:
+        """At the approach, heading yaw: turn to the goal's heading and creep in."""
+        arrive = np.vstack([_turn(approach, yaw, goal[2]), _leg(approach, goal[:2], goal[2])])
+        return clear(arrive, at_goal)
 
     lo = np.min([s.xy for s in surfaces], axis=0) - 1.0
     hi = np.max([s.xy for s in surfaces], axis=0) + 1.0
@@ -453,13 +454,15 @@ def plan_drive(
             continue
         leaving = at_start if back == 0 else frozenset()
         for approach in (goal[:2] - d * facing for d in APPROACH_DISTANCES):
-            h = _heading(out, approach)
-            if clear(_turn(out, start[2], h), leaving) and arrive_clear(out, start[2], approach):
+            moves, h = go(out, start[2], approach)
+            if clear(moves, leaving) and arrive_clear(approach, h):
                 return back, [approach]
             length = np.linalg.norm(vias - out, axis=1) + np.linalg.norm(vias - approach, axis=1)
             for via in vias[np.argsort(length)]:
-                h = _heading(out, via)
-                leave = np.vstack([_turn(out, start[2], h), _leg(out, via, h)])
-                if clear(leave, leaving) and arrive_clear(via, h, approach):
+                leave, h = go(out, start[2], via)
+                if not clear(leave, leaving):
+                    continue
+                moves, h = go(via, h, approach)
+                if clear(moves) and arrive_clear(approach, h):
                     return back, [via, approach]
     return None
