@@ -16,6 +16,7 @@ import socket
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -159,6 +160,20 @@ def test_viewer_nodes_follow_the_sim() -> None:
         # The arm rides along.
         assert np.linalg.norm(np.array(link1.position) - link1_0) > 0.1
         assert viewer.stats.updates == 1
+
+        # A resting body's creep is not sent (each pose sent makes the browser draw a frame,
+        # and a click waits behind it): under POSE_STEP_M from the pose last sent, the node
+        # keeps that pose; past it, it follows.
+        from laserpick.console.viewer import POSE_STEP_M
+
+        shown = np.array(scooter.position)
+        creep = snap.xpos.copy()
+        creep[b, 1] += 0.4 * POSE_STEP_M
+        viewer.update(replace(snap, xpos=creep, time=snap.time + 0.1))
+        np.testing.assert_allclose(scooter.position, shown, atol=1e-9)
+        creep[b, 1] += 2.0 * POSE_STEP_M
+        viewer.update(replace(snap, xpos=creep, time=snap.time + 0.2))
+        np.testing.assert_allclose(scooter.position, creep[b], atol=1e-6)
 
         # A new simulation (scene reset) rebuilds the nodes at the start pose.
         sim2 = Simulation(load_scene("isolation"), realtime=False)
