@@ -136,8 +136,21 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     # A free spot on the table, to the right of everything: the user's place mark.
     mark = np.array([1.45, -0.55, TABLE_TOP])
     frames = robot.capture()
+    # The hand lets go where the object touches the table, not above it: the guard on the
+    # way down must not take the grip itself for a contact.
+    let_go_at: list[float] = []
+    gripper = robot.gripper
+
+    def recording_gripper(close: bool) -> None:
+        if not close:
+            let_go_at.append(float(referee.world_position(name)[2]))
+        gripper(close)
+
+    robot.gripper = recording_gripper  # type: ignore[method-assign]
     out = b.place(fuse(frames), mark)
+    robot.gripper = gripper  # type: ignore[method-assign]
     assert out.ok, out.failure
+    assert let_go_at and let_go_at[0] - TABLE_TOP < 0.015, f"let go {let_go_at} m up"
     assert out.spot is not None and abs(out.spot[2] - TABLE_TOP) < 0.01
     assert not robot.gripper_state().closed
     robot.sleep(1.0)

@@ -469,9 +469,31 @@ class Simulation:
         return self._contact_force(self._pad_geoms)
 
     def _arm_contact_force(self) -> float:
-        """Force (N) on the arm and the gripper: what the UR5's joint-current force estimate
-        or a wrist force sensor would read."""
-        return self._contact_force(self._arm_geoms)
+        """Force (N) from outside on the arm and the gripper, and on what a closed gripper
+        holds: what the UR5's joint-current force estimate or a wrist force sensor would read.
+        The grip itself (the pads on the held object) is internal and not counted: counted,
+        it tripped every guarded place at once, and the object was let go from 10 cm up."""
+        if not self._grip_closed:
+            return self._contact_force(self._arm_geoms)
+        d, m = self.data, self.model
+        held_bodies = set()
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.geom1 in self._pad_geoms or c.geom2 in self._pad_geoms:
+                other = c.geom2 if c.geom1 in self._pad_geoms else c.geom1
+                held_bodies.add(int(m.geom_bodyid[other]))
+        if not held_bodies:
+            return self._contact_force(self._arm_geoms)
+        held = np.flatnonzero(np.isin(m.geom_bodyid, list(held_bodies)))
+        inside = self._arm_geoms | frozenset(held.tolist())
+        total = 0.0
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if (c.geom1 in inside) != (c.geom2 in inside):
+                mujoco.mj_contactForce(m, d, i, force)
+                total += abs(force[0])
+        return total
 
     def _publish(self) -> None:
         d, info = self.data, self.info
