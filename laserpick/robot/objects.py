@@ -49,9 +49,11 @@ OPTICAL_GROUP: dict[str, int] = {
 #: Alpha that transparent objects render with in the viewer.
 TRANSPARENT_ALPHA = 0.3
 #: Torsional and rolling friction of every object geom (m), after the sliding coefficient.
-OBJECT_FRICTION_TAIL = (0.005, 0.0001)
-#: Contact dimensionality of object geoms: sliding plus torsional friction.
-OBJECT_CONDIM = 4
+OBJECT_FRICTION_TAIL = (0.005, 0.0005)
+#: Contact dimensionality of object geoms: sliding, torsional and rolling friction. Without
+#: rolling friction (4) a can laid on its side crept into a roll and off its table within a
+#: minute. The pads' contacts take the pads' own (4): they have priority.
+OBJECT_CONDIM = 6
 #: Collision bitmasks shared with the robot model (two geoms touch if type_a & affinity_b or
 #: type_b & affinity_a): surfaces are static (type 1) and touch objects only; objects (type 2)
 #: touch the floor and surfaces (1), each other (2), the arm (4) and the scooter (8).
