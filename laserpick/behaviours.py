@@ -49,6 +49,8 @@ WORKSPACE_X = 1.25
 #: TCP heights (m) over the basket's rim to release at: the low ones for most objects, the
 #: high ones for a tall object held near its top, which hangs deep below the hand.
 DROP_HEIGHTS = (0.06, 0.10, 0.14, 0.20, 0.26)
+#: Drop postures tried in turn when no path to the better ones is found.
+DROP_TRIES = 3
 #: Falls (m) that differ by less than this rank alike when choosing a drop posture.
 FALL_STEP = 0.04
 #: Highest extra lift (m) to bring a held object clear before carrying it.
@@ -91,20 +93,38 @@ class Held:
 
 
 @functools.cache
-def drop_candidates() -> tuple[np.ndarray, ...]:
-    """Joint configurations that put the TCP over (or just inside) the basket's opening, the
-    arm clear of the scooter (rad). Computed once: the basket is fixed to the scooter."""
+def drop_candidates(tilted: bool = False) -> tuple[np.ndarray, ...]:
+    """Joint configurations for releasing over the basket, the arm clear of the scooter (rad).
+
+    Upright (the default): the TCP over (or just inside) the basket's opening, the gripper
+    pointing down or tilted up to 30 deg. Tilted: the gripper tilted 45-90 deg from down,
+    toward any side, its TCP up to 20 cm beside the opening: for a tall object held at its
+    top, which hangs too deep below a downward hand for any reachable height (the arm
+    reaches at most 26 cm above the rim pointing down), so it is laid over the opening
+    instead. Computed once each: the basket is fixed to the scooter.
+    """
     centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
     rim = centre[2] + inner[2] / 2
     free = CollisionChecker(np.zeros((0, 3)))
+    if tilted:
+        offsets = np.linspace(-0.2, 0.2, 5)
+        grid = itertools.product(
+            offsets,
+            offsets,
+            DROP_HEIGHTS,
+            np.radians(np.arange(0, 360, 30)),
+            np.radians((45, 60, 75, 90)),
+        )
+    else:
+        grid = itertools.product(
+            np.linspace(-0.3, 0.3, 3) * inner[0],
+            np.linspace(-0.3, 0.3, 3) * inner[1],
+            DROP_HEIGHTS,
+            np.radians(np.arange(0, 180, 30)),
+            np.radians((0, 15, 30)),
+        )
     out = []
-    for dx, dy, dz, yaw, tilt in itertools.product(
-        np.linspace(-0.3, 0.3, 3) * inner[0],
-        np.linspace(-0.3, 0.3, 3) * inner[1],
-        DROP_HEIGHTS,
-        np.radians(np.arange(0, 180, 30)),
-        np.radians((0, 15, 30)),
-    ):
+    for dx, dy, dz, yaw, tilt in grid:
         T = np.eye(4)
         T[:3, :3] = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down
         T[:3, 3] = [centre[0] + dx, centre[1] + dy, rim + dz]
@@ -299,39 +319,62 @@ class Behaviours:
 
     # --- drop and place -------------------------------------------------------------------
 
-    def drop_configuration(
+    def drop_configurations(
         self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
-    ) -> np.ndarray | None:
-        """A clear joint configuration with the held object over the basket's opening: the
-        gripper pointing down or tilted up to 30 deg, its TCP at one of DROP_HEIGHTS.
+    ) -> list[np.ndarray]:
+        """Clear joint configurations that hold the object over the basket's opening, best
+        first (rad): those of `drop_candidates()`, and where none of them holds the whole
+        object inside, the tilted ones after them.
 
         Postures that hold every point of the object inside the opening (1 cm in from the
         walls) come first, then those that hold its middle there; then the shortest fall
         (in FALL_STEP steps: a long fall bounces the object out); then the nearest to q_ref.
-        None when no clear posture holds even the middle over the opening: an object let go
-        there would fall beside the basket, onto the scooter or the floor.
+        A posture that does not hold even the middle over the opening is left out: an object
+        let go there would fall beside the basket, onto the scooter or the floor. Empty when
+        none is left.
         The basket sits close beside the arm's base, between the tiller, the sensor posts and
         the projector, so few postures reach over it: they are searched, not assumed.
         """
+        ranked = self._rank_drops(drop_candidates(), q_ref, checker, payload)
+        if not ranked or ranked[0][0][0] > 0:
+            ranked += self._rank_drops(drop_candidates(tilted=True), q_ref, checker, payload)
+        return [q for _, q in ranked]
+
+    @staticmethod
+    def _rank_drops(
+        candidates: Sequence[np.ndarray],
+        q_ref: np.ndarray,
+        checker: CollisionChecker,
+        payload: np.ndarray,
+    ) -> list[tuple[tuple[int, int, float], np.ndarray]]:
+        """The clear `candidates` that hold the object's middle over the opening, each with
+        its rank key (see `drop_configurations`), sorted."""
+        if not candidates:
+            return []
         lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
         hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
         floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
-        best: tuple[tuple[int, int, float], np.ndarray] | None = None
-        candidates = np.array(drop_candidates())
-        clear = checker.clearance_ok(candidates, payload=payload)
-        T = tcp_pose(candidates[clear])
-        for q, T_q in zip(candidates[clear], T, strict=True):
-            pts = payload @ T_q[:3, :3].T + T_q[:3, 3] if len(payload) else T_q[None, :3, 3]
-            xy = pts[:, :2]
-            middle = xy.mean(axis=0)
-            inside = 0 if np.all((xy >= lo) & (xy <= hi)) else 1
-            if inside and not np.all((middle >= lo) & (middle <= hi)):
-                continue
-            fall = int((pts[:, 2].min() - floor) // FALL_STEP)
-            key = (inside, fall, float(np.max(np.abs(q - q_ref))))
-            if best is None or key < best[0]:
-                best = (key, q)
-        return None if best is None else best[1]
+        Q = np.array(candidates)
+        T = tcp_pose(Q)
+        pts = payload if len(payload) else np.zeros((1, 3))
+        held = np.einsum("bij,pj->bpi", T[:, :3, :3], pts) + T[:, None, :3, 3]  # (B, P, 3)
+        xy = held[..., :2]
+        middle = xy.mean(axis=1)
+        middle_in = np.all((middle >= lo) & (middle <= hi), axis=1)
+        Q, held, xy = Q[middle_in], held[middle_in], xy[middle_in]
+        # In chunks: the check's arrays grow with candidates x payload points x spheres.
+        clear = np.concatenate(
+            [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
+            or [np.zeros(0, bool)]
+        )
+        inside = (~np.all((xy >= lo) & (xy <= hi), axis=(1, 2))).astype(int)
+        fall = ((held[..., 2].min(axis=1) - floor) // FALL_STEP).astype(int)
+        near = np.max(np.abs(Q - q_ref), axis=1)
+        ranked = [
+            ((int(inside[i]), int(fall[i]), float(near[i])), Q[i]) for i in np.flatnonzero(clear)
+        ]
+        ranked.sort(key=lambda kq: kq[0])
+        return ranked
 
     def _rise_clear(self, held: Held) -> Failure | None:
         """Lift straight up, 5 cm at a time and at most RISE_MAX, until the held object is
@@ -390,21 +433,24 @@ class Behaviours:
             self.held = None
             return Outcome(Failure("precondition", "The hand is not holding anything."))
         held = self.held
-        q_drop = self.drop_configuration(self._q(), held.surroundings, held.points_tcp)
-        if q_drop is None:
+        drops = self.drop_configurations(self._q(), held.surroundings, held.points_tcp)
+        if not drops:
             msg = "The arm cannot hold the object over the basket; it keeps it."
             return Outcome(Failure("ik_plan", msg))
         self.progress("Carrying the object to the basket.")
         failure = self._rise_clear(held)
         if failure is not None:
             return Outcome(failure)
-        out = self.go_to(
-            q_drop,
-            held.surroundings,
-            "carrying to the basket",
-            via=(dims.UR5_HIGH_READY_Q,),
-            payload=held.points_tcp,
-        )
+        for q_drop in drops[:DROP_TRIES]:
+            out = self.go_to(
+                q_drop,
+                held.surroundings,
+                "carrying to the basket",
+                via=(dims.UR5_HIGH_READY_Q,),
+                payload=held.points_tcp,
+            )
+            if out.ok or out.failure is None or out.failure.kind != "ik_plan":
+                break  # there, or a motion was stopped: no other posture is tried
         if not out.ok:
             return out
         lost = self._lost_on_the_way("the basket")

@@ -4,10 +4,12 @@ basket (judged by the simulator)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from laserpick.behaviours import Behaviours
+from laserpick.behaviours import Behaviours, drop_candidates
 from laserpick.bench.operator import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -24,6 +26,7 @@ from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import matrix_from_quat
 
 TABLE_TOP = 0.46  # the isolation scene's table (m)
+DATA = Path(__file__).parent / "data"
 
 
 @pytest.fixture
@@ -169,3 +172,52 @@ def test_place_on_a_non_surface_is_refused_and_keeps_the_object(robot):
     out = b.place(fuse(robot.capture()), np.array([1.5, -0.3, 1.2]))  # mid-air
     assert out.failure is not None and out.failure.kind == "precondition"
     assert robot.gripper_state().holding
+
+
+def _box_points(size: tuple[float, float, float], step: float = 0.01) -> np.ndarray:
+    """Points (m) filling a box of `size` whose top face's middle is the origin, reaching
+    down along +z: a box held at its top by a downward hand, in the TCP frame."""
+    axes = [np.arange(-s / 2, s / 2 + 1e-9, step) for s in size[:2]]
+    axes.append(np.arange(0.0, size[2] + 1e-9, step))
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def test_a_tall_object_held_at_its_top_is_laid_over_the_basket(robot):
+    """A 25 cm cereal box held at its top hangs too deep for a downward hand to hold it above
+    the basket's rim (the arm reaches 26 cm above it): no upright posture is clear, and a
+    tilted one holds its middle over the opening instead."""
+    payload = _box_points((0.19, 0.06, 0.24))
+    free = CollisionChecker(np.zeros((0, 3)))
+    upright = np.array(drop_candidates())
+    assert not free.clearance_ok(upright, payload=payload).any()
+    b = Behaviours(robot)
+    drops = b.drop_configurations(dims.UR5_READY_Q, free, payload)
+    assert drops, "a tilted posture holds it over the opening"
+    lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2
+    hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2
+    for q in drops[:3]:
+        T = tcp_pose(q)
+        held = payload @ T[:3, :3].T + T[:3, 3]
+        middle = held[:, :2].mean(axis=0)
+        assert np.all((middle > lo) & (middle < hi))
+        assert held[:, 2].min() > dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
+        assert free.clearance_ok(q, payload=payload)[0]
+
+
+def test_a_tall_object_is_picked_and_dropped_in_the_basket():
+    robot = SimRobot(load_scene(str(DATA / "tall_object.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        referee = Referee(robot)
+        name = "cereal_box_1"
+        perception = perceive(robot.capture(), point=referee.aim_point(name))
+        found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+        assert isinstance(found, GraspSet), found
+        b = Behaviours(robot)
+        assert b.pick(found).ok
+        dropped = b.drop_in_basket()
+        assert dropped.ok, dropped.failure
+        robot.sleep(1.0)
+        assert referee.in_basket(name)
+    finally:
+        robot.close()
