@@ -59,6 +59,10 @@ RISE_MAX = 0.20
 CARRIED_PADDING = 0.03
 #: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
 PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
+#: How far (rad) the arm may be from a trajectory's start when it is sent, and how long (s)
+#: it is waited for to get there (the controller refuses a start 0.05 rad off).
+START_TOLERANCE = 0.02
+START_WAIT = 1.0
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
 MOTION_SLACK = 3.0
 
@@ -161,6 +165,13 @@ class Behaviours:
     def _run(self, traj: Trajectory, what: str) -> Failure | None:
         if self.should_stop():
             return Failure("execute", f"Stopped before {what}: the motion was cancelled.")
+        # A trajectory ends by its clock while the servos may still lag; the controller
+        # refuses one that starts more than 0.05 rad from where the arm is. So let the arm
+        # catch up with the start first (a few tenths of a second at most).
+        waited = 0.0
+        while np.max(np.abs(self._q() - traj.q[0])) > START_TOLERANCE and waited < START_WAIT:
+            self.robot.sleep(0.05)
+            waited += 0.05
         handle = self.robot.execute(traj)
         status = self.robot.wait(handle, traj.duration + MOTION_SLACK)
         if status == "done":
