@@ -93,6 +93,32 @@ def thin(points: np.ndarray, voxel: float) -> np.ndarray:
     return keep
 
 
+def mirrored_back(
+    target: np.ndarray, normals: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """The unseen back of an object, guessed by symmetry: its seen points (N, 3) (m, `base`)
+    turned half a turn about the vertical axis through the middle of its top, and their
+    outward normals (N, 3) turned with them (None without `normals`).
+
+    The cameras see an object from the front and above only. Most household objects (boxes,
+    bottles, cans, cups) are symmetric under that half turn, so it fills in their back. The
+    axis is the middle of the top band's extent: the top is seen whole from above, while the
+    band's mean would lean toward the cameras, where the seen sides add points.
+    """
+    target = np.asarray(target, float).reshape(-1, 3)
+    if len(target) == 0:
+        return target.copy(), None if normals is None else np.zeros((0, 3))
+    top = target[target[:, 2] > target[:, 2].max() - CARRIED_TOP_BAND]
+    middle = (top[:, :2].min(axis=0) + top[:, :2].max(axis=0)) / 2
+    back = target.copy()
+    back[:, :2] = 2.0 * middle - target[:, :2]
+    if normals is None:
+        return back, None
+    turned = np.array(normals, float).reshape(-1, 3)
+    turned[:, :2] *= -1.0
+    return back, turned
+
+
 def carried_shape(
     target: np.ndarray, support: float | None = None, voxel: float = CARRIED_VOXEL
 ) -> np.ndarray:
@@ -103,21 +129,15 @@ def carried_shape(
     The cameras see an object from the front and above only, so its back half, and near a
     table's edge its lower part, are missing from `target` (N, 3); a carry planned around
     the seen part alone swung a mug's unseen back into the forearm, and a soda can's unseen
-    lower half into the upper arm. Mirroring fills in the back of a box or a cylinder; each
-    `voxel` (m) column of the footprint is filled down to `support` (m, the surface's height;
-    None: no filling), since the object stands on it. Other shapes are over-covered, which
-    only makes the planner more careful. The axis is the middle of the top band's extent (the
-    top is seen whole from above; the band's mean would lean toward the cameras, where the
-    seen sides add points). Thinned to one point per `voxel`.
+    lower half into the upper arm. `mirrored_back` fills in the back of a box or a cylinder;
+    each `voxel` (m) column of the footprint is filled down to `support` (m, the surface's
+    height; None: no filling), since the object stands on it. Other shapes are over-covered,
+    which only makes the planner more careful. Thinned to one point per `voxel`.
     """
     target = np.asarray(target, float).reshape(-1, 3)
     if len(target) == 0:
         return target
-    top = target[target[:, 2] > target[:, 2].max() - CARRIED_TOP_BAND]
-    middle = (top[:, :2].min(axis=0) + top[:, :2].max(axis=0)) / 2
-    mirrored = target.copy()
-    mirrored[:, :2] = 2.0 * middle - target[:, :2]
-    both = np.vstack([target, mirrored])
+    both = np.vstack([target, mirrored_back(target)[0]])
     if support is not None:
         columns, which = np.unique(np.floor(both[:, :2] / voxel), axis=0, return_inverse=True)
         low = np.full(len(columns), np.inf)

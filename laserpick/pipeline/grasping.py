@@ -2,7 +2,8 @@
 three strategies:
 
 - "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004);
-  when none of them is reachable, the "vertical" grasp instead.
+  when none of them is reachable, again on the target with its unseen back filled in by
+  symmetry; when still none is, the "vertical" grasp instead.
 - "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
 - "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
   takes once its base has centred the object (003 section IV).
@@ -21,7 +22,7 @@ from typing import Literal
 import numpy as np
 
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_HIGH_READY_Q, UR5_READY_Q
-from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.collision import CollisionChecker, mirrored_back
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
@@ -99,16 +100,25 @@ def vertical_grasp(
 
 
 def candidates(
-    perception: Perception, strategy: Strategy, settings: Settings, rng: np.random.Generator
+    perception: Perception,
+    strategy: Strategy,
+    settings: Settings,
+    rng: np.random.Generator,
+    *,
+    complete: bool = False,
 ) -> list[Grasp] | Failure:
-    """Raw grasp candidates on the perceived target."""
+    """Raw grasp candidates on the perceived target. complete: for "gpd", add the target's
+    back as `mirrored_back` guesses it (to the target and to the obstacles)."""
     cloud, seg = perception.cloud, perception.segmentation
     assert seg is not None
     target = cloud.points[seg.indices].astype(np.float64)
     if strategy == "gpd":
-        return detect_grasps(
-            target, cloud.normals[seg.indices], cloud.points, settings.grasp, rng=rng
-        )
+        normals, scene = cloud.normals[seg.indices], cloud.points
+        if complete:
+            back, back_normals = mirrored_back(target, normals)
+            target, normals = np.vstack([target, back]), np.vstack([normals, back_normals])
+            scene = np.vstack([scene, back])
+        return detect_grasps(target, normals, scene, settings.grasp, rng=rng)
     support = seg.surface.height if seg.surface is not None else None
     if strategy == "overhead":
         floor = support if support is not None else float(target[:, 2].min())
@@ -154,9 +164,20 @@ def find_grasps(
     checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
     if strategy == "gpd" and not any(g.ik is not None for g in checked):
-        # GPD needs both sides of a grasp in view and room for the hand toward them: a low,
-        # a round or a near object may offer no reachable candidate. The centroid top grasp
-        # (Jeeves') is then the fallback.
+        # GPD needs both sides of a grasp in view. Seen from the front only (a tall bottle
+        # off to the side has no seen face opposite a seen face), its back is guessed by
+        # symmetry, as Bohg et al. complete a partial view, and the detection runs again.
+        t0 = time.perf_counter()
+        again = candidates(perception, "gpd", s, rng, complete=True)
+        timings["detect"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        if not isinstance(again, Failure):
+            checked += reachable(again, world, q_ref, approach)
+        timings["filter"] += time.perf_counter() - t0
+    if strategy == "gpd" and not any(g.ik is not None for g in checked):
+        # A low, a round or a near object may still offer no reachable candidate, or no
+        # room for the hand toward them. The centroid top grasp (Jeeves') is then the
+        # fallback.
         t0 = time.perf_counter()
         fallback = candidates(perception, "vertical", s, rng)
         timings["detect"] += time.perf_counter() - t0
