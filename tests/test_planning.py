@@ -202,6 +202,25 @@ def test_rrt_connect_goes_around_a_wall_and_every_step_is_clear():
     assert via is not None and len(via) > 2
 
 
+def test_joint_path_from_a_blocked_start_gives_up_without_searching():
+    """A start inside an obstacle can never be left: the search is not run (it spent all of
+    its 2000 samples, 12 s, on a held can guessed into the forearm)."""
+    q0 = ik_tcp(top_grasp(1.6, -0.5, 0.40), dims.UR5_READY_Q)[0]  # the hand in the table
+    q1 = ik_tcp(top_grasp(1.6, 0.1, 0.65), dims.UR5_READY_Q)[0]
+    checker = CollisionChecker(table(), voxel=0.0)
+    assert not checker.clearance_ok(q0)[0] and checker.clearance_ok(q1)[0]
+    checked: list[int] = []
+    clearance_ok = checker.clearance_ok
+
+    def counting(Q, **kw):
+        checked.append(len(np.atleast_2d(Q)))
+        return clearance_ok(Q, **kw)
+
+    checker.clearance_ok = counting  # type: ignore[method-assign]
+    assert joint_path(q0, q1, checker, np.random.default_rng(0), get_settings().motion) is None
+    assert len(checked) == 2, "the straight segment and the ends, no search"
+
+
 def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
     s = get_settings().motion
     world = CollisionChecker(table())

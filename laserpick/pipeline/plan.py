@@ -146,9 +146,13 @@ def joint_path(
     s: MotionSettings,
     **kw,
 ) -> np.ndarray | None:
-    """A clear joint path: the straight one if clear, else RRT-Connect, shortened."""
+    """A clear joint path: the straight one if clear, else RRT-Connect, shortened. None at
+    once when the start or the goal is not clear: no edge can leave it, and the search would
+    spend all its samples (seconds) finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
         return np.array([q_start, q_goal], float)
+    if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
+        return None
     path = rrt_connect(
         q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
     )
