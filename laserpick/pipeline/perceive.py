@@ -63,15 +63,20 @@ def perceive(
     point: Sequence[float] | None = None,
     method: SegmentationMethod = "cluster",
     settings: PerceptionSettings | None = None,
+    cloud: FusedCloud | None = None,
 ) -> Perception:
     """Fuse the frames, find the mark, and segment the object under it.
 
     The mark comes from the laser dots in the IR images, or, when `point` is given, directly
-    from that point in `base` (m): a click, a touch screen or an API call.
+    from that point in `base` (m): a click, a touch screen or an API call. cloud: the frames
+    already fused with these settings (a click was aimed in it), so as not to fuse them again.
     """
     s = settings or get_settings().perception
     timings: dict[str, float] = {}
-    cloud = _timed(timings, "fuse", lambda: fuse(frames, s))
+    if cloud is None:
+        cloud = _timed(timings, "fuse", lambda: fuse(frames, s))
+    else:
+        timings["fuse"] = 0.0
     mark = _timed(
         timings,
         "detect_laser",

@@ -649,8 +649,16 @@ class Session:
         t0 = time.perf_counter()
         frames = list(fresh.frames) if fresh is not None else self.robot.capture()
         captured = time.perf_counter() - t0
-        perception = perceive(frames, point=point, settings=self.settings.perception)
-        self._remember(frames, perception.cloud)
+        perception = perceive(
+            frames,
+            point=point,
+            settings=self.settings.perception,
+            cloud=None if fresh is None else fresh.cloud,
+        )
+        if fresh is None:
+            # A fresh capture's cloud is remembered already: the same object, so the views
+            # do not send the whole cloud again just as the highlight should show.
+            self._remember(frames, perception.cloud)
         lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
         with self._lock:
             self.task.timings = {"capture": captured, **perception.timings}
