@@ -213,3 +213,25 @@ def test_non_loopback_host_needs_the_password() -> None:
     assert "LASERPICK_OPERATOR_PASSWORD" in out.stderr
     assert "loopback" in out.stderr
     assert "console at" not in out.stdout
+
+
+def test_lit_points_are_looked_up_by_their_projector_pixel() -> None:
+    """The lit points are those whose projector pixel (computed once per cloud) the image
+    lights: a point on the axis of a lit pixel is lit, one beside it, one behind the lens or
+    one outside the image is not."""
+    from laserpick.console.operator_console import lit_by, projector_pixels
+    from laserpick.pipeline.projector import Projector, projector_intrinsics
+
+    w, h = 64, 48
+    K = projector_intrinsics(w, h, 0.64, 0.48, 0.32, 0.24, 1.0)  # 100 px per metre at 1 m
+    projector = Projector(K, np.eye(4), w, h)  # the optical frame is `base` here
+
+    def at(u: float, v: float, z: float = 1.0) -> list[float]:
+        return [(u - K[0, 2]) / K[0, 0] * z, (v - K[1, 2]) / K[1, 1] * z, z]
+
+    points = np.array([at(10, 20), at(11, 20), at(10, 20, z=-1.0), at(80, 20), at(10, 20, 2.0)])
+    pixels = projector_pixels(projector, points)
+    assert list(pixels) == [20 * w + 10, 20 * w + 11, -1, -1, 20 * w + 10]
+    image = np.zeros((h, w), np.uint8)
+    image[20, 10] = 255
+    assert list(lit_by(image, pixels)) == [True, False, False, False, True]

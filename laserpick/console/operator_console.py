@@ -108,6 +108,9 @@ class _Drawn:
     place_key: tuple[float, ...] | None = None
     laser_key: tuple[float, ...] | None = None
     nodes: dict[str, viser.SceneNodeHandle] = field(default_factory=dict)
+    #: The projector pixel of each point of the cloud `pixels_of` (`projector_pixels`).
+    pixels: np.ndarray | None = None
+    pixels_of: int | None = None
 
 
 class OperatorConsole:
@@ -345,10 +348,16 @@ class OperatorConsole:
             self._drawn.cloud_key = self._drawn.lit_key = None
             return
         cloud, pose = latest
+        if self._drawn.pixels_of != id(cloud):
+            # Once per cloud, as it arrives (a click aims in it): a highlight in it is then
+            # a lookup, not a projection of its 200k points just when the user waits.
+            self._drawn.pixels = projector_pixels(self.session.projector, cloud.points)
+            self._drawn.pixels_of = id(cloud)
         if lit_key != self._drawn.lit_key:
             self._drawn.lit_key = lit_key
+            assert self._drawn.pixels is not None
             lit = (
-                cloud.points[lit_by(self.session.projector, image, cloud.points)]
+                cloud.points[lit_by(image, self._drawn.pixels)]
                 if image is not None
                 else cloud.points[:0]
             )
@@ -566,12 +575,18 @@ def tcp_path(grasp: Grasp, lift: float = 0.10) -> np.ndarray:
     return np.array([[pre, at], [at, up]])
 
 
-def lit_by(projector: Projector, image: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Mask of the points (N, 3) m in `base` that the projector image lights (pixel > 0)."""
+def projector_pixels(projector: Projector, points: np.ndarray) -> np.ndarray:
+    """The flat index (N,) into the projector image of the pixel each point (N, 3) (m,
+    `base`) falls on; -1 for a point outside the image or behind the projector. It depends
+    only on the points: the projector is fixed to the scooter, the cloud is in `base`."""
     uv, front = projector.project(points)
     px = np.round(uv).astype(np.int64)
-    h, w = image.shape
+    w, h = projector.width, projector.height
     inside = front & (px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0) & (px[:, 1] < h)
-    lit = np.zeros(len(points), bool)
-    lit[inside] = image[px[inside, 1], px[inside, 0]] > 0
-    return lit
+    return np.where(inside, px[:, 1] * w + px[:, 0], -1)
+
+
+def lit_by(image: np.ndarray, pixels: np.ndarray) -> np.ndarray:
+    """Mask of the points whose projector pixels (N,) (`projector_pixels`) the image
+    (height x width) lights (pixel > 0)."""
+    return (pixels >= 0) & (image.ravel()[np.maximum(pixels, 0)] > 0)
