@@ -6,9 +6,11 @@ click's pointerdown in the browser to the 3D view sending the lit cloud to the b
 `highlight` event on the events stream). Both clocks are this machine's wall clock. Not
 counted: the loopback hop back to the browser and the frame that draws it; the script
 prints the browser's frame interval beside the figure for that. Between trials the mark is
-cancelled.
+cancelled. `--pause S` waits S seconds between the aiming click taking effect and the
+confirming click, as a person does who looks at the dot before confirming it; at 0 (the
+default) the confirming click lands while the browser is still drawing the aim.
 
-    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--no-browser]
+    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--pause S] [--no-browser]
 
 `--no-browser` measures the server alone, in this process: the session, the 3D view's drawing
 and its viser server without a browser, from a click-confirmed mark (`Session.confirm` with
@@ -59,6 +61,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
     parser.add_argument("--no-browser", action="store_true", help="the server's share alone")
+    parser.add_argument(
+        "--pause",
+        type=float,
+        default=0.0,
+        help="seconds between the aiming click taking effect and the confirming click (a"
+        " person looks at the dot first); 0: at once",
+    )
     args = parser.parse_args()
     if args.no_browser:
         return server_only(args.rounds)
@@ -85,6 +94,7 @@ def main() -> int:
                         x, y = box["x"] + x, box["y"] + y
                         page.mouse.click(x, y)
                         api.wait_for(lambda s: s["state"] == "aiming" and not s["busy"], 20)
+                        time.sleep(args.pause)
                         seen = len(api.events)
                         page.mouse.click(x, y)
                         # The click reaches the server on its own path: wait until it has
