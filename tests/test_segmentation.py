@@ -267,3 +267,32 @@ def test_small_cluster_falls_back_to_the_ball():
     assert isinstance(seg, Segmentation) and seg.method == "ball"
     d = np.linalg.norm(cloud.points[seg.indices] - mark, axis=1)
     assert d.max() <= SETTINGS.fallback_ball_radius + 1e-6
+
+
+def test_a_floor_filling_the_view_is_found_around_the_mark():
+    """Before an object on the floor, the floor is nearly all of the cloud: more than 004's
+    70 %, so it is not removed as a plane. It is found in the crop around the mark instead,
+    and the box standing on it is segmented alone."""
+    rng = np.random.default_rng(0)
+    g = np.arange(-0.5, 0.5, 0.003)
+    x, y = np.meshgrid(g, g)
+    floor = np.column_stack([1.5 + x.ravel(), y.ravel(), np.zeros(x.size)])
+    floor = floor[~((np.abs(x.ravel()) < 0.03) & (np.abs(y.ravel()) < 0.03))]
+    s = np.arange(-0.03, 0.03, 0.003)
+    sides = [np.column_stack([np.full(s.size, c), s]) for c in (-0.03, 0.03)]
+    sides += [np.column_stack([s, np.full(s.size, c)]) for c in (-0.03, 0.03)]
+    ring = np.concatenate(sides)
+    box = [np.column_stack([1.5 + ring[:, 0], ring[:, 1], np.full(len(ring), z)]) for z in s + 0.03]
+    sx, sy = np.meshgrid(s, s)
+    box.append(np.column_stack([1.5 + sx.ravel(), sy.ravel(), np.full(sx.size, 0.06)]))
+    box_pts = np.concatenate(box)
+    pts = np.concatenate([floor, box_pts])
+    cloud = _synthetic(pts + rng.normal(0, 0.001, pts.shape))
+    _, planes = remove_horizontal_planes(cloud, SETTINGS)
+    assert not planes, "the floor is over 70 % of the cloud: 004's rule keeps it"
+    seg = segment_target(cloud, np.array([1.5, 0.0, 0.06], np.float32), SETTINGS)
+    assert isinstance(seg, Segmentation) and seg.method == "cluster"
+    assert seg.surface is not None and abs(seg.surface.height) < 0.005
+    truth = np.zeros(len(cloud), bool)
+    truth[-len(box_pts) :] = True
+    assert iou(_mask(seg, len(cloud)), truth) > 0.9

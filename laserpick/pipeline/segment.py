@@ -186,6 +186,22 @@ def euclidean_clusters(points: np.ndarray, tolerance: float) -> np.ndarray:
 # --- the target -------------------------------------------------------------------------------
 
 
+def _crop_plane(
+    cloud: FusedCloud, crop: np.ndarray, settings: PerceptionSettings, seed: int = 0
+) -> SupportSurface | None:
+    """The horizontal plane with the most support among the cloud's points `crop` (indices),
+    if it has the inliers `remove_horizontal_planes` asks of a plane; else None."""
+    up = cloud.normals[crop, 2] >= math.cos(math.radians(settings.plane_candidate_tilt_deg))
+    plane = _best_horizontal_plane(cloud.points, crop[up], settings, np.random.default_rng(seed))
+    if plane is None:
+        return None
+    inl = np.zeros(len(cloud), bool)
+    inl[crop] = np.abs(plane_distance(cloud.points[crop], plane)) <= settings.plane_distance
+    if np.count_nonzero(inl) < min_plane_inliers(settings):
+        return None
+    return SupportSurface(height=_height_at_centroid(cloud.points, inl, plane), plane=plane)
+
+
 def _surface_under(
     points: np.ndarray, mark: np.ndarray, planes: list[SupportSurface], settings
 ) -> SupportSurface | None:
@@ -219,6 +235,17 @@ def _segment_cluster(
     crop = np.flatnonzero(d2 <= settings.cluster_crop_radius**2)
     crop_pts = pts[crop]
     surface = _surface_under(crop_pts, mark, planes, settings)
+    if surface is None:
+        # One plane filling the view (the floor before the scooter) holds more than 004's
+        # 70 % of the cloud and stays; the object would be clustered with it. It is looked
+        # for in the crop around the mark instead, by the same RANSAC. Our addition to 004.
+        local = _crop_plane(cloud, crop, settings)
+        if local is not None:
+            on_plane = np.abs(plane_distance(crop_pts, local.plane)) <= settings.plane_distance
+            keep = keep.copy()
+            keep[crop[on_plane]] = False
+            planes = [*planes, local]
+            surface = _surface_under(crop_pts, mark, planes, settings)
     # Plane removal at 1.5 cm also strips every object's bottom 1.5 cm (and all of a phone).
     # Removed points clearly above their plane, beyond the depth noise, rejoin the clustering,
     # so the cluster regrows into them through the same 5 mm chains. Our addition to 004.
