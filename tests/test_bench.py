@@ -17,15 +17,19 @@ from PIL import Image
 from laserpick.bench import PROTOCOL_NAMES
 from laserpick.bench.operator import (
     DRIVE_MARGIN,
+    PARK_FLOOR_REACH,
+    Footprint,
     Outline,
     _at,
     _clearance,
     _leg,
     _turn,
+    parked_clear,
     parking_pose,
     plan_drive,
 )
 from laserpick.bench.protocols import (
+    FLOOR_TURNS,
     JEEVES_MODELS,
     PROTOCOLS,
     Options,
@@ -37,8 +41,10 @@ from laserpick.bench.report import markdown
 from laserpick.bench.results import outcomes, summarize
 from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
+from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.robot.scenes import load_scene, scene_config
+from laserpick.transforms import invert, planar_pose
 
 DATA = Path(__file__).parent / "data"
 
@@ -81,6 +87,29 @@ def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
     # The user's old way, straight from the table to 0.8 m before the counter, hit the table.
     straight = _leg(start[:2] - 0.6 * np.array([1.0, 0.0]), waypoints[-1], 0.0)
     assert _clearance([table], _at(straight, outline.points())).min() < DRIVE_MARGIN
+
+
+def test_the_user_parks_at_a_floor_object_from_a_side_with_nothing_under_the_scooter() -> None:
+    """Facing the kitchen floor's +x, the tissue packet 1.45 m ahead puts the plush toy
+    under the scooter: wholly inside its outline, which the outline's edges alone never
+    meet. The user parks from another side, the packet before the arm."""
+    scene = load_scene("kitchen", seed=1)
+    floor = scene.surface("floor_area")
+    outline = Outline((-0.15, 1.30), (-0.68, 0.38))  # the referee's, with the arm stowed
+    tissue = scene.placement("tissue_packet").pos[:2]
+    toy = Footprint("stuffed_toy", tuple(scene.placement("stuffed_toy").pos[:2]), 0.0, (0.1, 0.1))
+    packet = Footprint("tissue_packet", tuple(tissue), 0.0, (0.11, 0.03))
+    around = [*(s for s in scene.surfaces if s.kind != "floor"), toy, packet]
+    lx, ly = floor.to_local(tissue)
+    straight = parking_pose(floor, ly, 0.0, local_x=lx)
+    assert _clearance([toy], _at(straight[None], outline.points())).min() > DRIVE_MARGIN
+    assert not parked_clear(straight, around, outline)
+    goals = [parking_pose(floor, ly, 0.0, local_x=lx, turn=t) for t in FLOOR_TURNS]
+    clear = [g for g in goals if parked_clear(g, around, outline)]
+    assert clear
+    for goal in clear:
+        in_base = invert(planar_pose(*goal)) @ np.array([*tissue, 0.0, 1.0])
+        assert np.allclose(in_base[:2], [PARK_FLOOR_REACH, dims.ARM_MOUNT_POS[1]], atol=1e-9)
 
 
 def test_every_jeeves_object_stands_at_every_location() -> None:

@@ -37,6 +37,10 @@ PARK_SPOT_DEPTH = 0.25
 #: edge stands 16 cm before the mount, and no path led from the stowed arm to the ready pose).
 PARK_EDGE = 1.30
 PARK_EDGE_HIGH = 1.40
+#: m from the rear axle to an object on the floor the user parks at: 15 cm ahead of the
+#: scooter's front (1.30 m), inside the arm's reach down to the floor. A floor is no
+#: obstacle: the user drives onto it, around the objects lying there.
+PARK_FLOOR_REACH = 1.45
 #: m the scripted user keeps every part of the scooter, arm and held object included, from
 #: the furniture when driving between surfaces. The simulated scooter pushes furniture aside
 #: and sweeps objects off it; a careful user does neither.
@@ -226,21 +230,33 @@ def scene_config_backed(name: str, back: float) -> dict:
     return config
 
 
-def parking_pose(surface: Surface, local_y: float = 0.0, level: float | None = None) -> np.ndarray:
+def parking_pose(
+    surface: Surface,
+    local_y: float = 0.0,
+    level: float | None = None,
+    local_x: float | None = None,
+    turn: float = 0.0,
+) -> np.ndarray:
     """Where the user parks to work on `surface` at height `level` (m; default its lowest
     level): facing it, its front edge PARK_EDGE ahead of the rear axle (PARK_EDGE_HIGH when
     the level is above the arm's shoulder) and the spot `local_y` (m, the surface's frame)
-    in front of the arm. Returns (x, y, yaw) in `world` (m, rad)."""
+    in front of the arm. On a floor, with the spot's `local_x` (m) given, the spot itself
+    PARK_FLOOR_REACH ahead instead, the scooter facing the floor's +x turned by `turn`
+    (rad): a floor may be driven onto from any side. Returns (x, y, yaw) in `world` (m,
+    rad)."""
     level = surface.levels[0] if level is None else level
     edge = PARK_EDGE_HIGH if level > dims.ARM_MOUNT_POS[2] + dims.UR5_D[0] else PARK_EDGE
+    c, s = math.cos(surface.yaw), math.sin(surface.yaw)
+    ahead = edge + PARK_SPOT_DEPTH
+    spot_local = np.array([-surface.size[0] / 2 + PARK_SPOT_DEPTH, local_y])
     yaw = surface.yaw  # the front faces the surface's local -x: face its +x
-    c, s = math.cos(yaw), math.sin(yaw)
-    front_x = -surface.size[0] / 2
-    spot_local = np.array([front_x + PARK_SPOT_DEPTH, local_y])
+    if surface.kind == "floor" and local_x is not None:
+        ahead, spot_local, yaw = PARK_FLOOR_REACH, np.array([local_x, local_y]), yaw + turn
     spot = np.asarray(surface.xy) + np.array(
         [c * spot_local[0] - s * spot_local[1], s * spot_local[0] + c * spot_local[1]]
     )
-    reach = np.array([edge + PARK_SPOT_DEPTH, dims.ARM_MOUNT_POS[1]])
+    c, s = math.cos(yaw), math.sin(yaw)
+    reach = np.array([ahead, dims.ARM_MOUNT_POS[1]])
     origin = spot - np.array([c * reach[0] - s * reach[1], s * reach[0] + c * reach[1]])
     return np.array([origin[0], origin[1], yaw])
 
@@ -262,11 +278,15 @@ class Outline:
     x: tuple[float, float]
     y: tuple[float, float]
 
-    def points(self, step: float = 0.05) -> np.ndarray:
-        """Points along the rectangle's edges (m, `base` xy), at most `step` apart."""
+    def points(self, step: float = 0.05, filled: bool = False) -> np.ndarray:
+        """Points along the rectangle's edges (m, `base` xy), at most `step` apart; filled:
+        a grid over the whole rectangle instead."""
         (x0, x1), (y0, y1) = self.x, self.y
         nx, ny = int(np.ceil((x1 - x0) / step)) + 1, int(np.ceil((y1 - y0) / step)) + 1
         xs, ys = np.linspace(x0, x1, nx), np.linspace(y0, y1, ny)
+        if filled:
+            gx, gy = np.meshgrid(xs, ys)
+            return np.c_[gx.ravel(), gy.ravel()]
         return np.vstack(
             [
                 np.c_[xs, np.full(nx, y0)],
@@ -282,7 +302,7 @@ def drive_to(
     goal: np.ndarray,
     *,
     reverse_first: float = 0.0,
-    around: Sequence[Surface] = (),
+    around: Sequence[Surface | Footprint] = (),
     outline: Outline | None = None,
 ) -> bool:
     """Drive like a careful user: back out `reverse_first` m, drive to a point 0.8 m in
@@ -362,7 +382,56 @@ def _go_point(driver: Driver, xy: np.ndarray, speed: float = 0.5) -> None:
     _drive_loop(driver, cmd)
 
 
-def _clearance(surfaces: Sequence[Surface], xy: np.ndarray) -> np.ndarray:
+@dataclass(frozen=True)
+class Footprint:
+    """A rectangle on the floor the scooter must keep off: `name`, centre `xy` (m, `world`),
+    `yaw` (rad) and `size` (m, along and across). A surface is one too."""
+
+    name: str
+    xy: tuple[float, float]
+    yaw: float
+    size: tuple[float, float]
+
+
+def obstacles(
+    surfaces: Sequence[Surface], referee: Referee, keep_off: Sequence[str]
+) -> list[Surface | Footprint]:
+    """What the user drives around: every surface but a floor (they drive onto that), and
+    the objects `keep_off` where they lie on the floor, each as its bounding rectangle."""
+    out: list[Surface | Footprint] = [s for s in surfaces if s.kind != "floor"]
+    T_world_base = invert(referee._T_base_world())
+    for name in keep_off:
+        pts = referee.object_points(name)
+        if pts[:, 2].min() > 0.05:  # not on the floor
+            continue
+        world = pts @ T_world_base[:3, :3].T + T_world_base[:3, 3]
+        lo, hi = world[:, :2].min(axis=0), world[:, :2].max(axis=0)
+        out.append(Footprint(name, tuple((lo + hi) / 2), 0.0, tuple(hi - lo)))
+    return out
+
+
+def parked_clear(pose: np.ndarray, around: Sequence[Surface | Footprint], outline: Outline) -> bool:
+    """Whether the scooter with `outline`, standing at `pose` (x, y, yaw in `world`), keeps
+    DRIVE_MARGIN from everything `around`: where it parks on a floor, nothing is to be in
+    reach of its front but the object."""
+    return _gap(pose[None], around, outline) >= DRIVE_MARGIN
+
+
+def _gap(poses: np.ndarray, around: Sequence[Surface | Footprint], outline: Outline) -> float:
+    """The least distance (m) from the scooter with `outline`, at any of the poses (K x 3:
+    x, y, yaw in `world`), to anything `around`. Furniture meets the outline's edges first;
+    an object on the floor (a Footprint) can be smaller and lie wholly inside it, so it is
+    measured from points over the whole outline."""
+    furniture = [a for a in around if not isinstance(a, Footprint)]
+    small = [a for a in around if isinstance(a, Footprint)]
+    gap = float(_clearance(furniture, _at(poses, outline.points())).min(initial=np.inf))
+    if small:
+        inside = _at(poses, outline.points(filled=True))
+        gap = min(gap, float(_clearance(small, inside).min()))
+    return gap
+
+
+def _clearance(surfaces: Sequence[Surface | Footprint], xy: np.ndarray) -> np.ndarray:
     """Distance (m) from each of the points `xy` (N x 2, `world`) to the nearest of the
     surfaces' footprints; inf without surfaces."""
     out = np.full(len(xy), np.inf)
@@ -405,7 +474,7 @@ def _heading(a: np.ndarray, b: np.ndarray) -> float:
 def plan_drive(
     start: np.ndarray,
     goal: np.ndarray,
-    surfaces: Sequence[Surface],
+    surfaces: Sequence[Surface | Footprint],
     outline: Outline,
     reverse_first: float = 0.0,
 ) -> tuple[float, list[np.ndarray]] | None:
@@ -420,15 +489,13 @@ def plan_drive(
     moves that leave the start and that reach the goal may touch the surfaces the scooter
     touches there: it is parked at them."""
     start, goal = np.asarray(start, float), np.asarray(goal, float)
-    local = outline.points()
 
     def clear(poses: np.ndarray, exempt: frozenset[str] = frozenset()) -> bool:
         others = [s for s in surfaces if s.name not in exempt]
-        return bool(np.all(_clearance(others, _at(poses, local)) >= DRIVE_MARGIN))
+        return _gap(poses, others, outline) >= DRIVE_MARGIN
 
     def touching(pose: np.ndarray) -> frozenset[str]:
-        points = _at(pose[None], local)
-        return frozenset(s.name for s in surfaces if _clearance([s], points).min() < DRIVE_MARGIN)
+        return frozenset(s.name for s in surfaces if _gap(pose[None], [s], outline) < DRIVE_MARGIN)
 
     at_start, at_goal = touching(start), touching(goal)
     facing = np.array([math.cos(goal[2]), math.sin(goal[2])])

@@ -38,8 +38,12 @@ import yaml
 
 from laserpick.bench.operator import (
     PARK_SPOT_DEPTH,
+    Outline,
     drive_to,
+    obstacles,
+    parked_clear,
     parking_pose,
+    plan_drive,
     scene_config_backed,
 )
 from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
@@ -61,6 +65,9 @@ from laserpick.transforms import invert, matrix_from_quat, planar_pose
 
 #: Tries per object in the in-situ protocol (004 section 8.2 retried until retrieved).
 MAX_TRIES = 3
+#: Headings (rad, from the floor's +x) the user tries, in order, to park at an object on a
+#: floor: the other objects lying there may block a side.
+FLOOR_TURNS = tuple(math.radians(a) for a in (0, 45, -45, 90, -90, 135, -135, 180))
 #: A placed object counts as upright when its up axis is tilted under this (rad) from how it
 #: stood before, and as on target within this distance (m) of the mark plus its offset.
 UPRIGHT_TILT = math.radians(15.0)
@@ -284,18 +291,49 @@ def _local_y(surface: Surface, scene: Scene, instance: str) -> float:
     return float(surface.to_local(scene.placement(instance).pos[:2])[1])
 
 
+def _around(op: ScriptedOperator, scene: Scene) -> list:
+    """What the user drives around: the furniture, and the objects lying on the floor."""
+    return obstacles(scene.surfaces, op.referee, op.referee.instances())
+
+
 def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str) -> bool:
     """Drive from wherever the scooter is to park in front of the object's surface, the
-    object before the arm. Returns whether it parked."""
+    object before the arm (on the floor: before the object itself). Returns whether it
+    parked."""
     placement = scene.placement(instance)
     surface = scene.surface(placement.surface)
     level = surface.levels[placement.level]
-    goal = parking_pose(surface, _local_y(surface, scene, instance), level)
-    if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
-        return True
-    return drive_to(
-        op, goal, reverse_first=0.6, around=scene.surfaces, outline=op.referee.outline()
-    )
+    local_x, local_y = surface.to_local(op.referee.world_position(instance)[:2])
+    return _park(op, scene, surface, float(local_x), float(local_y), level)
+
+
+def _park(
+    op: ScriptedOperator,
+    scene: Scene,
+    surface: Surface,
+    local_x: float,
+    local_y: float,
+    level: float,
+    outline: Outline | None = None,
+) -> bool:
+    """Drive to work at the spot (local x, y: m in the surface's frame; level: its height)
+    and say whether the user parked there. A floor may be driven onto from any side: the
+    user tries each of FLOOR_TURNS in turn until one leads there."""
+    turns = FLOOR_TURNS if surface.kind == "floor" else (0.0,)
+    outline = outline or op.referee.outline()
+    around = _around(op, scene)
+    for turn in turns:
+        goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn)
+        if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
+            return True
+        blocked = turn != turns[-1] and (
+            not parked_clear(goal, around, outline)
+            or plan_drive(op.base_pose(), goal, around, outline, 0.6) is None
+        )
+        if blocked:
+            continue
+        return drive_to(op, goal, reverse_first=0.6, around=around, outline=outline)
+    return False
 
 
 def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
@@ -403,9 +441,9 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     if spot is None:
         return rec.fail("precondition", f"no free spot on {dest.name}")
     local_y, spot_world = spot
-    parking = parking_pose(dest, local_y, spot_world[2])
+    local_x = float(dest.to_local(spot_world[:2])[0])
     outline = op.referee.outline()  # the object in hand included
-    if not drive_to(op, parking, reverse_first=0.6, around=scene.surfaces, outline=outline):
+    if not _park(op, scene, dest, local_x, local_y, spot_world[2], outline):
         return rec.fail("precondition", f"the user could not park at {dest.name}")
     spot_base = (invert(planar_pose(*op.base_pose())) @ np.append(spot_world, 1.0))[:3]
     placed = op.place(spot_base)
