@@ -63,6 +63,8 @@ PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
 #: it is waited for to get there (the controller refuses a start 0.05 rad off).
 START_TOLERANCE = 0.02
 START_WAIT = 1.0
+#: Still this far (rad) from the start after the wait, the arm is held back: by contact.
+START_STUCK = 0.05
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
 MOTION_SLACK = 3.0
 
@@ -172,6 +174,12 @@ class Behaviours:
         while np.max(np.abs(self._q() - traj.q[0])) > START_TOLERANCE and waited < START_WAIT:
             self.robot.sleep(0.05)
             waited += 0.05
+        if np.max(np.abs(self._q() - traj.q[0])) > START_STUCK:
+            self.robot.halt()
+            return Failure(
+                "execute",
+                f"The arm stopped short of where {what} starts: it may be touching something.",
+            )
         handle = self.robot.execute(traj)
         status = self.robot.wait(handle, traj.duration + MOTION_SLACK)
         if status == "done":

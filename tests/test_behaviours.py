@@ -238,3 +238,16 @@ def test_a_motion_waits_for_the_arm_to_reach_its_start(robot):
     second = timed(np.array([q1, q0]), b.settings.motion)
     assert b._run(second, "returning") is None
     assert np.abs(robot.joint_state().q - q0).max() < 0.02
+
+
+def test_a_motion_whose_start_the_arm_does_not_reach_fails_saying_so(robot):
+    """An arm held back short of a motion's start (by contact, say) is not sent a motion the
+    controller would refuse with a message no user can read."""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    q0 = robot.joint_state().q
+    elsewhere = q0 + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])  # nothing takes the arm there
+    failure = b._run(timed(np.array([elsewhere, q0]), b.settings.motion), "approaching")
+    assert failure is not None and failure.kind == "execute"
+    assert "stopped short of where approaching starts" in failure.message
+    assert np.abs(robot.joint_state().q - q0).max() < 0.02, "the arm stays where it was"
