@@ -38,6 +38,7 @@ import yaml
 
 from laserpick.bench.operator import (
     PARK_SPOT_DEPTH,
+    Footprint,
     Outline,
     drive_to,
     obstacles,
@@ -291,7 +292,7 @@ def _local_y(surface: Surface, scene: Scene, instance: str) -> float:
     return float(surface.to_local(scene.placement(instance).pos[:2])[1])
 
 
-def _around(op: ScriptedOperator, scene: Scene) -> list:
+def _around(op: ScriptedOperator, scene: Scene) -> list[Surface | Footprint]:
     """What the user drives around: the furniture, and the objects lying on the floor."""
     return obstacles(scene.surfaces, op.referee, op.referee.instances())
 

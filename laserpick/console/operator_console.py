@@ -40,7 +40,7 @@ from laserpick.description import dims
 from laserpick.pipeline.cloud import voxel_first
 from laserpick.pipeline.projector import Projector
 from laserpick.pipeline.reach import pregrasp_pose
-from laserpick.pipeline.types import Grasp
+from laserpick.pipeline.types import FusedCloud, Grasp
 from laserpick.server.lease import CONSOLE, LeaseHeld
 from laserpick.server.session import Actor, Conflict, Session, TaskState
 from laserpick.transforms import planar_pose
@@ -108,9 +108,10 @@ class _Drawn:
     place_key: tuple[float, ...] | None = None
     laser_key: tuple[float, ...] | None = None
     nodes: dict[str, viser.SceneNodeHandle] = field(default_factory=dict)
-    #: The projector pixel of each point of the cloud `pixels_of` (`projector_pixels`).
+    #: The projector pixel of each point of the cloud `pixels_of` (`projector_pixels`); the
+    #: cloud itself is kept, not its id, which a new cloud may reuse once it is freed.
     pixels: np.ndarray | None = None
-    pixels_of: int | None = None
+    pixels_of: FusedCloud | None = None
 
 
 class OperatorConsole:
@@ -348,11 +349,11 @@ class OperatorConsole:
             self._drawn.cloud_key = self._drawn.lit_key = None
             return
         cloud, pose = latest
-        if self._drawn.pixels_of != id(cloud):
+        if self._drawn.pixels_of is not cloud:
             # Once per cloud, as it arrives (a click aims in it): a highlight in it is then
             # a lookup, not a projection of its 200k points just when the user waits.
             self._drawn.pixels = projector_pixels(self.session.projector, cloud.points)
-            self._drawn.pixels_of = id(cloud)
+            self._drawn.pixels_of = cloud
         if lit_key != self._drawn.lit_key:
             self._drawn.lit_key = lit_key
             assert self._drawn.pixels is not None
