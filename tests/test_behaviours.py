@@ -125,14 +125,21 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     assert not robot.gripper_state().closed
 
 
-def test_picked_object_is_placed_upright_at_the_mark(robot):
+def _pick(robot: SimRobot, name: str) -> tuple[Behaviours, Referee]:
+    """Perceive the object at its aim point, find its grasps and pick it, as a session does."""
     referee = Referee(robot)
-    name = "mug_1"
     perception = perceive(robot.capture(), point=referee.aim_point(name))
     found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
     assert isinstance(found, GraspSet), found
     b = Behaviours(robot)
-    assert b.pick(found).ok
+    out = b.pick(found)
+    assert out.ok, out.failure
+    return b, referee
+
+
+def test_picked_object_is_placed_upright_at_the_mark(robot):
+    name = "mug_1"
+    b, referee = _pick(robot, name)
     tcp = tcp_pose(robot.joint_state().q)[:3, 3]
     offset = (referee.position(name) - tcp)[:2]
     up0 = matrix_from_quat(referee.world_quat(name)).T @ [0.0, 0.0, 1.0]
@@ -164,11 +171,7 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
 
 
 def test_place_on_a_non_surface_is_refused_and_keeps_the_object(robot):
-    referee = Referee(robot)
-    perception = perceive(robot.capture(), point=referee.aim_point("mug_1"))
-    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
-    b = Behaviours(robot)
-    assert b.pick(found).ok
+    b, _ = _pick(robot, "mug_1")
     out = b.place(fuse(robot.capture()), np.array([1.5, -0.3, 1.2]))  # mid-air
     assert out.failure is not None and out.failure.kind == "precondition"
     assert robot.gripper_state().holding
@@ -208,13 +211,8 @@ def test_a_tall_object_is_picked_and_dropped_in_the_basket():
     robot = SimRobot(load_scene(str(DATA / "tall_object.yaml"), seed=1), realtime=False)
     try:
         robot.sim.settle(0.5)
-        referee = Referee(robot)
         name = "cereal_box_1"
-        perception = perceive(robot.capture(), point=referee.aim_point(name))
-        found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
-        assert isinstance(found, GraspSet), found
-        b = Behaviours(robot)
-        assert b.pick(found).ok
+        b, referee = _pick(robot, name)
         dropped = b.drop_in_basket()
         assert dropped.ok, dropped.failure
         robot.sleep(1.0)
