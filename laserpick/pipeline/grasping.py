@@ -164,32 +164,32 @@ def find_grasps(
     )
     checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
+
+    def add(kind: Strategy, complete: bool = False, most: int | None = None) -> bool:
+        """Detect `kind` candidates and filter them (at most `most`, evenly sampled) into
+        `checked`, timed. False when the detection failed."""
+        t0 = time.perf_counter()
+        more = candidates(perception, kind, s, rng, complete=complete)
+        timings["detect"] += time.perf_counter() - t0
+        if isinstance(more, Failure):
+            return False
+        t0 = time.perf_counter()
+        step = 1 if most is None else max(1, -(-len(more) // most))
+        checked.extend(reachable(more[::step], world, q_ref, approach))
+        timings["filter"] += time.perf_counter() - t0
+        return True
+
     if strategy == "gpd" and not any(g.ik is not None for g in checked):
         # GPD needs both sides of a grasp in view. Seen from the front only (a tall bottle
         # off to the side has no seen face opposite a seen face), its back is guessed by
         # symmetry, as Bohg et al. complete a partial view, and the detection runs again.
-        t0 = time.perf_counter()
-        again = candidates(perception, "gpd", s, rng, complete=True)
-        timings["detect"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        if not isinstance(again, Failure):
-            # A whole object offers many more grasps (800 on a ball) than its seen part, and
-            # the filter's time grows with them: an even sample of them is filtered.
-            step = max(1, -(-len(again) // COMPLETED_MAX))
-            checked += reachable(again[::step], world, q_ref, approach)
-        timings["filter"] += time.perf_counter() - t0
-    if strategy == "gpd" and not any(g.ik is not None for g in checked):
-        # A low, a round or a near object may still offer no reachable candidate, or no
-        # room for the hand toward them. The centroid top grasp (Jeeves') is then the
-        # fallback.
-        t0 = time.perf_counter()
-        fallback = candidates(perception, "vertical", s, rng)
-        timings["detect"] += time.perf_counter() - t0
-        if not isinstance(fallback, Failure):
-            t0 = time.perf_counter()
-            checked += reachable(fallback, world, q_ref, approach)
-            timings["filter"] += time.perf_counter() - t0
-            strategy = "vertical"
+        # A whole object offers many more grasps (800 on a ball) than its seen part, and
+        # the filter's time grows with them: an even sample of them is filtered.
+        add("gpd", complete=True, most=COMPLETED_MAX)
+    # A low, a round or a near object may still offer no reachable candidate, or no room
+    # for the hand toward them. The centroid top grasp (Jeeves') is then the fallback.
+    if strategy == "gpd" and not any(g.ik is not None for g in checked) and add("vertical"):
+        strategy = "vertical"
     if isinstance(found, Failure) and not checked:
         return found
     if not checked:

@@ -452,14 +452,16 @@ class Simulation:
             return True
         return False
 
-    def _contact_force(self, geoms: frozenset[int]) -> float:
-        """Summed normal force (N) of the contacts that touch any of `geoms`."""
+    def _contact_force(self, geoms: frozenset[int], *, from_outside: bool = False) -> float:
+        """Summed normal force (N) of the contacts that touch any of `geoms`; from_outside:
+        only of those between one of `geoms` and a geom not among them."""
         d = self.data
         total = 0.0
         force = np.zeros(6)
         for i in range(d.ncon):
             c = d.contact[i]
-            if c.geom1 in geoms or c.geom2 in geoms:
+            a, b = c.geom1 in geoms, c.geom2 in geoms
+            if (a != b) if from_outside else (a or b):
                 mujoco.mj_contactForce(self.model, d, i, force)
                 total += abs(force[0])
         return total
@@ -485,15 +487,7 @@ class Simulation:
         if not held_bodies:
             return self._contact_force(self._arm_geoms)
         held = np.flatnonzero(np.isin(m.geom_bodyid, list(held_bodies)))
-        inside = self._arm_geoms | frozenset(held.tolist())
-        total = 0.0
-        force = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            if (c.geom1 in inside) != (c.geom2 in inside):
-                mujoco.mj_contactForce(m, d, i, force)
-                total += abs(force[0])
-        return total
+        return self._contact_force(self._arm_geoms | frozenset(held.tolist()), from_outside=True)
 
     def _publish(self) -> None:
         d, info = self.data, self.info
