@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Literal, Protocol
 
 import mujoco
 import numpy as np
@@ -107,10 +107,15 @@ class Referee:
         mujoco.mj_kinematics(self.robot.model, d)
         return d
 
-    def object_points(self, instance: str, posed: mujoco.MjData | None = None) -> np.ndarray:
-        """Points filling the object's bounds (m, `base`): its meshes' vertices, and a 7 x 7 x
-        7 grid over each primitive geom's box. Enough to say which object a grasp closes on.
-        posed: the state to read (default: now)."""
+    def object_points(
+        self,
+        instance: str,
+        posed: mujoco.MjData | None = None,
+        frame: Literal["base", "world"] = "base",
+    ) -> np.ndarray:
+        """Points filling the object's bounds (m, in `frame`): its meshes' vertices, and a 7 x
+        7 x 7 grid over each primitive geom's box. Enough to say which object a grasp closes
+        on. posed: the state to read (default: now)."""
         m = self.robot.model
         d = posed if posed is not None else self._posed()
         b = self.robot.sim.info.object_bodies[instance]
@@ -126,6 +131,8 @@ class Referee:
                 local = centre + np.array(np.meshgrid(grid, grid, grid)).reshape(3, -1).T * half
             pts.append(local @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g])
         world = np.vstack(pts)
+        if frame == "world":
+            return world
         return (self._T_base_world() @ np.c_[world, np.ones(len(world))].T).T[:, :3]
 
     def all_object_points(self) -> dict[str, np.ndarray]:
@@ -322,6 +329,16 @@ def drive_to(
         if plan is None:
             return False
         reverse_first, waypoints = plan
+    return follow(driver, goal, reverse_first, waypoints)
+
+
+def follow(
+    driver: Driver, goal: np.ndarray, reverse_first: float, waypoints: Sequence[np.ndarray]
+) -> bool:
+    """Drive a way to `goal` (x, y, yaw in `world`), as `plan_drive` gives it: back out
+    `reverse_first` m, drive through the waypoints (m, `world` xy), turn to the goal's
+    heading and creep in. Returns whether the scooter ended within 3 cm and 2 deg of it."""
+    goal = np.asarray(goal, float)
     if reverse_first > 0:
         start = driver.base_pose()[:2].copy()
         _drive_loop(driver, lambda p: (-0.3, 0.0, np.linalg.norm(p[:2] - start) >= reverse_first))
@@ -399,12 +416,10 @@ def obstacles(
     """What the user drives around: every surface but a floor (they drive onto that), and
     the objects `keep_off` where they lie on the floor, each as its bounding rectangle."""
     out: list[Surface | Footprint] = [s for s in surfaces if s.kind != "floor"]
-    T_world_base = invert(referee._T_base_world())
     for name in keep_off:
-        pts = referee.object_points(name)
-        if pts[:, 2].min() > 0.05:  # not on the floor
+        world = referee.object_points(name, frame="world")
+        if world[:, 2].min() > 0.05:  # not on the floor
             continue
-        world = pts @ T_world_base[:3, :3].T + T_world_base[:3, 3]
         lo, hi = world[:, :2].min(axis=0), world[:, :2].max(axis=0)
         out.append(Footprint(name, tuple((lo + hi) / 2), 0.0, tuple(hi - lo)))
     return out

@@ -41,6 +41,7 @@ from laserpick.bench.operator import (
     Footprint,
     Outline,
     drive_to,
+    follow,
     obstacles,
     parked_clear,
     parking_pose,
@@ -327,13 +328,14 @@ def _park(
         goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn)
         if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
             return True
-        blocked = turn != turns[-1] and (
-            not parked_clear(goal, around, outline)
-            or plan_drive(op.base_pose(), goal, around, outline, 0.6) is None
-        )
-        if blocked:
+        last = turn == turns[-1]
+        if not last and not parked_clear(goal, around, outline):
             continue
-        return drive_to(op, goal, reverse_first=0.6, around=around, outline=outline)
+        plan = plan_drive(op.base_pose(), goal, around, outline, 0.6)
+        if plan is not None:
+            return follow(op, goal, *plan)
+        if last:
+            return False
     return False
 
 
