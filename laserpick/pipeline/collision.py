@@ -84,6 +84,8 @@ CARRIED_VOXEL = 0.02
 CARRIED_TOP_BAND = 0.02
 #: A held object is checked against the arm's bodies up to this one (3: wrist 1).
 PAYLOAD_CLEAR_OF_BODY = 3
+#: A joint segment's every this-many-th configuration is checked before the rest.
+SEGMENT_COARSE = 8
 
 
 def thin(points: np.ndarray, voxel: float) -> np.ndarray:
@@ -315,4 +317,11 @@ class CollisionChecker:
         rad of the largest joint motion (0.03 rad moves a 0.9 m reach by under 3 cm)."""
         n = max(2, math.ceil(float(np.max(np.abs(qb - qa))) / step) + 1)
         Q = np.linspace(qa, qb, n)
-        return bool(self.clearance_ok(Q, **kw).all())  # type: ignore[arg-type]
+        # Every SEGMENT_COARSE-th configuration first: a blocked segment (most of those a
+        # planner tries) is then rejected after an eighth of the work.
+        coarse = np.zeros(n, bool)
+        coarse[::SEGMENT_COARSE] = coarse[-1] = True
+        for part in (Q[coarse], Q[~coarse]):
+            if len(part) and not self.clearance_ok(part, **kw).all():  # type: ignore[arg-type]
+                return False
+        return True

@@ -66,17 +66,29 @@ def cartesian_line(
 def shortcut(
     path: np.ndarray, checker: CollisionChecker, rng: np.random.Generator, tries: int = 60, **kw
 ) -> np.ndarray:
-    """Shorten a joint path by joining random pairs of its points where the join is clear."""
-    path = [np.asarray(q) for q in path]
+    """Shorten a joint path by joining random pairs of its points where the join is clear.
+
+    A join found blocked is not checked again; the search ends early when every join left
+    has been."""
+    points = [np.asarray(q) for q in path]
+    keep = list(range(len(points)))  # indices into `points` of the path so far
+    blocked: set[tuple[int, int]] = set()
     for _ in range(tries):
-        if len(path) < 3:
+        if len(keep) < 3:
             break
-        i, j = sorted(rng.choice(len(path), size=2, replace=False))
-        if j - i < 2:
+        joins = (len(keep) - 1) * (len(keep) - 2) // 2  # pairs with a point between them
+        on_path = set(keep)
+        if sum(a in on_path and b in on_path for a, b in blocked) >= joins:
+            break
+        i, j = sorted(rng.choice(len(keep), size=2, replace=False))
+        pair = (keep[i], keep[j])
+        if j - i < 2 or pair in blocked:
             continue
-        if checker.segment_ok(path[i], path[j], **kw):
-            path = path[: i + 1] + path[j:]
-    return np.array(path)
+        if checker.segment_ok(points[pair[0]], points[pair[1]], **kw):
+            keep = keep[: i + 1] + keep[j:]
+        else:
+            blocked.add(pair)
+    return np.array([points[k] for k in keep])
 
 
 def rrt_connect(
