@@ -276,7 +276,8 @@ class Behaviours:
         failure = self._run(guarded, "approaching the object")
         if failure and "unexpected contact" in failure.message:
             self._back_off()
-            msg = "The hand touched something on its way in, stopped and backed off."
+            touched = failure.message.split("unexpected contact: ", 1)[1].rstrip(".")
+            msg = f"The hand touched something on its way in ({touched}), stopped and backed off."
             return Outcome(Failure("execute", msg), grasp, attempts, timings)
         if failure:
             return Outcome(failure, grasp, attempts, timings)

@@ -62,6 +62,7 @@ def test_guarded_trajectory_stops_on_contact(robot):
     handle = robot.execute(guarded)
     status = robot.wait(handle, traj.duration + 2.0)
     assert status == "failed" and "unexpected contact" in handle.message
+    assert "finger_" in handle.message and " met " in handle.message  # says what touched
     robot.sleep(0.2)
     s = robot.sim.snapshot()
     assert np.abs(s.arm_qd).max() < 0.05, "the arm must be at rest after the stop"

@@ -385,9 +385,12 @@ class Simulation:
                         self._grip_closed = event.action == "close"
                         self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
                     guard = motion.traj.guard_force
-                    if guard is not None and (force := self._arm_contact_force()) > guard:
-                        self._halt("failed", f"unexpected contact: {force:.0f} N on the arm")
-                        return
+                    if guard is not None:
+                        contacts = self._arm_contacts()
+                        if sum(f for f, _, _ in contacts) > guard:
+                            report = self._contact_report(contacts)
+                            self._halt("failed", f"unexpected contact: {report}")
+                            return
                     if motion.finished(d.time):
                         self._end_motion("done")
                 else:
@@ -452,31 +455,36 @@ class Simulation:
             return True
         return False
 
-    def _contact_force(self, geoms: frozenset[int], *, from_outside: bool = False) -> float:
-        """Summed normal force (N) of the contacts that touch any of `geoms`; from_outside:
-        only of those between one of `geoms` and a geom not among them."""
+    def _contacts(
+        self, geoms: frozenset[int], *, from_outside: bool = False
+    ) -> list[tuple[float, int, int]]:
+        """(normal force (N), geom among `geoms`, the other geom) of each contact touching
+        any of `geoms`; from_outside: only those between one of `geoms` and one not among
+        them."""
         d = self.data
-        total = 0.0
+        out = []
         force = np.zeros(6)
         for i in range(d.ncon):
             c = d.contact[i]
             a, b = c.geom1 in geoms, c.geom2 in geoms
             if (a != b) if from_outside else (a or b):
                 mujoco.mj_contactForce(self.model, d, i, force)
-                total += abs(force[0])
-        return total
+                ours, other = (c.geom1, c.geom2) if a else (c.geom2, c.geom1)
+                out.append((abs(float(force[0])), int(ours), int(other)))
+        return out
 
     def _gripper_force(self) -> float:
         """Force (N) on the pads: what the gripper's own current sensing reports."""
-        return self._contact_force(self._pad_geoms)
+        return sum(f for f, _, _ in self._contacts(self._pad_geoms))
 
-    def _arm_contact_force(self) -> float:
-        """Force (N) from outside on the arm and the gripper, and on what a closed gripper
-        holds: what the UR5's joint-current force estimate or a wrist force sensor would read.
-        The grip itself (the pads on the held object) is internal and not counted: counted,
-        it tripped every guarded place at once, and the object was let go from 10 cm up."""
+    def _arm_contacts(self) -> list[tuple[float, int, int]]:
+        """The contacts from outside on the arm and the gripper, and on what a closed gripper
+        holds, as `_contacts` gives them: their sum is what the UR5's joint-current force
+        estimate or a wrist force sensor would read. The grip itself (the pads on the held
+        object) is internal and not counted: counted, it tripped every guarded place at once,
+        and the object was let go from 10 cm up."""
         if not self._grip_closed:
-            return self._contact_force(self._arm_geoms)
+            return self._contacts(self._arm_geoms)
         d, m = self.data, self.model
         held_bodies = set()
         for i in range(d.ncon):
@@ -485,9 +493,19 @@ class Simulation:
                 other = c.geom2 if c.geom1 in self._pad_geoms else c.geom1
                 held_bodies.add(int(m.geom_bodyid[other]))
         if not held_bodies:
-            return self._contact_force(self._arm_geoms)
+            return self._contacts(self._arm_geoms)
         held = np.flatnonzero(np.isin(m.geom_bodyid, list(held_bodies)))
-        return self._contact_force(self._arm_geoms | frozenset(held.tolist()), from_outside=True)
+        return self._contacts(self._arm_geoms | frozenset(held.tolist()), from_outside=True)
+
+    def _contact_report(self, contacts: list[tuple[float, int, int]]) -> str:
+        """'{N} N on the arm, most where {body} met {body}': what a guarded stop says."""
+        _, ours, other = max(contacts)
+        body = self.model.geom_bodyid
+        ours_name, other_name = (
+            self.model.body(int(body[g])).name or "the world" for g in (ours, other)
+        )
+        total = sum(f for f, _, _ in contacts)
+        return f"{total:.0f} N on the arm, most where {ours_name} met {other_name}"
 
     def _publish(self) -> None:
         d, info = self.data, self.info
