@@ -69,6 +69,15 @@ START_STUCK = 0.05
 MOTION_SLACK = 3.0
 
 
+def turned_hand_xy(spot_xy: np.ndarray, middle_xy: np.ndarray, dyaw: float) -> np.ndarray:
+    """Where the hand goes (m, `base` xy) to set an object down turned by dyaw (rad) about
+    the vertical, so that its middle lands where it would unturned with the hand at
+    spot_xy. middle_xy: the object's middle from the hand, unturned (m). The turn is about
+    the object's middle: about the hand, an object held 7 cm off its middle would land
+    14 cm from where it should when turned a half turn."""
+    return np.asarray(spot_xy, float) + middle_xy - rotz(dyaw)[:2, :2] @ middle_xy
+
+
 @dataclass(frozen=True)
 class Outcome:
     """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage;
@@ -434,6 +443,9 @@ class Behaviours:
         held = self.held
         if held is None:
             return Outcome(Failure("precondition", "The hand is not holding anything."))
+        failure = self._rise_clear(held)
+        if failure is not None:
+            return Outcome(failure)
         out = self.go_to(
             dims.UR5_CARRY_Q,
             held.surroundings,
@@ -540,15 +552,18 @@ class Behaviours:
         """Where to set the object down at `spot` (m, `base`): the joint angles above it, the
         straight path down, and the pose above. The grasp's orientation is kept, so that the
         object stands as it stood, turned about the vertical if the arm cannot reach it
-        unturned (PLACE_YAWS): a turned object still stands upright."""
+        unturned (PLACE_YAWS): a turned object still stands upright, and where it would have
+        stood unturned (the hand over the mark, 004 section 7.3)."""
         s = self.settings.motion
         reached = False
+        # The middle of the held object, from the hand (m, `base` axes at the grasp).
+        pts = held.points_tcp @ held.grasp.pose[:3, :3].T
+        middle = (pts.min(axis=0) + pts.max(axis=0)) / 2 if len(pts) else np.zeros(3)
         for dyaw in PLACE_YAWS:
             T_place = held.grasp.pose.copy()
             T_place[:3, :3] = rotz(dyaw) @ T_place[:3, :3]
             T_place[:3, 3] = [
-                spot[0],
-                spot[1],
+                *turned_hand_xy(spot[:2], middle[:2], dyaw),
                 spot[2] + held.height_above_support + s.place_clearance,
             ]
             T_above = T_place.copy()

@@ -32,7 +32,9 @@ from laserpick.bench.protocols import (
     FLOOR_TURNS,
     JEEVES_MODELS,
     PROTOCOLS,
+    UPRIGHT_TILT,
     Options,
+    _up_in_object,
     coin_flip_kitchen,
     jeeves_scene,
     scan_points,
@@ -44,7 +46,7 @@ from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.robot.scenes import load_scene, scene_config
-from laserpick.transforms import invert, planar_pose
+from laserpick.transforms import invert, planar_pose, quat_from_matrix, rotx, rotz
 
 DATA = Path(__file__).parent / "data"
 
@@ -262,3 +264,18 @@ def test_retries_at_one_object_count_as_one_task() -> None:
     assert s["grasp_success_rate"] == pytest.approx(1 / 3)
     assert s["failures"]["ik_plan"] == 1 and s["failures"]["wrong_object"] == 1
     assert s["objects"]["mug"]["task_success"] == 1
+
+
+def test_a_lying_object_set_down_turned_about_the_vertical_still_counts_as_upright():
+    """A can on its side, set down a quarter turn about the vertical (a place may turn it),
+    rests as it rested; tipped onto its end, it does not. The object's own z axis turned 90
+    degrees in both, and the first counted as tipped over."""
+    lying = rotx(math.pi / 2)
+    before = _up_in_object(quat_from_matrix(lying))
+
+    def tilt(R: np.ndarray) -> float:
+        return math.acos(float(np.clip(before @ _up_in_object(quat_from_matrix(R)), -1, 1)))
+
+    assert tilt(rotz(math.pi / 2) @ lying) < 1e-6
+    assert tilt(rotz(math.pi) @ lying) < 1e-6
+    assert tilt(np.eye(3)) > UPRIGHT_TILT  # stood on its end

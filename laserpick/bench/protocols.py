@@ -416,13 +416,21 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     return out
 
 
+def _up_in_object(quat: np.ndarray) -> np.ndarray:
+    """The world's up in the frame of an object at orientation `quat` (w, x, y, z): it stays
+    put when the object turns about the vertical. (The object's own z axis does not: a can
+    lying on its side and set down turned a quarter turn, as a place may turn it, counted as
+    tipped 90 degrees.)"""
+    return matrix_from_quat(quat).T @ np.array([0.0, 0.0, 1.0])
+
+
 def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     """One 004 section 8.3 task: pick `rec.instance` and set it down on another surface."""
     session, referee = op.session, op.referee
     if not _go_to_object(op, scene, rec.instance):
         return rec.fail("precondition", "the user could not park in front of it")
     session.set_mode(op.actor, mode="pick_and_place")
-    up_before = matrix_from_quat(referee.world_quat(rec.instance))[:, 2]
+    up_before = _up_in_object(referee.world_quat(rec.instance))
     if not op.pick(rec) or rec.failure is not None:
         return rec
     if session.state != TaskState.AWAITING_PLACE:
@@ -455,7 +463,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
         return rec.fail(failure.kind, failure.message)
     op.robot.sleep(0.5)
     error = float(np.linalg.norm(referee.position(rec.instance)[:2] - placed.hit[:2] - offset))
-    up_now = matrix_from_quat(referee.world_quat(rec.instance))[:, 2]
+    up_now = _up_in_object(referee.world_quat(rec.instance))
     tilt = math.acos(float(np.clip(up_before @ up_now, -1.0, 1.0)))
     rec.surface = f"{here} -> {dest.name}"
     if tilt > UPRIGHT_TILT:
