@@ -167,6 +167,8 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     robot.sleep(1.0)
     error = np.linalg.norm(referee.position(name)[:2] - (out.spot[:2] + offset))
     assert error < 0.03, f"{error * 100:.1f} cm from where it should stand"
+    # The arm folded away around it: stowed, and the object where it was set down.
+    assert np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) < 0.05
     up = matrix_from_quat(referee.world_quat(name)) @ up0
     assert up[2] > np.cos(np.radians(15)), "it should stand as it stood"
 
