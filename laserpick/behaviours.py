@@ -502,7 +502,8 @@ class Behaviours:
         mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
-        down from 10 cm above, guarded, then the hand opens and rises straight back.
+        down from 10 cm above, guarded, then the hand opens and rises straight back, and
+        the arm stows around the object where it now stands.
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -553,8 +554,10 @@ class Behaviours:
             np.vstack([obstacles, standing]), margin=s.clearance, q_self=q_now
         )
         back = self.stow(around)
-        if not back.ok:
-            return Outcome(back.failure, held.grasp, spot=spot)
+        if back.failure is not None:
+            msg = back.failure.message
+            failure = Failure(back.failure.kind, f"Set down; then {msg[:1].lower()}{msg[1:]}")
+            return Outcome(failure, held.grasp, spot=spot)
         self.progress("Placed.")
         return Outcome(None, held.grasp, spot=spot)
 
