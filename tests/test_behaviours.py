@@ -175,7 +175,7 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
 
 def test_a_turned_placement_turns_the_object_about_its_middle():
     """An object held 7 cm off its middle, set down turned, stands where it would unturned:
-    turned about the hand, it landed up to 14 cm away."""
+    turned about the hand, it would land up to 14 cm away."""
     spot = np.array([1.5, -0.3])
     middle = np.array([0.05, -0.05])  # the object's middle from the hand, unturned
     for dyaw in PLACE_YAWS:
