@@ -334,8 +334,6 @@ def _park(
         plan = plan_drive(op.base_pose(), goal, around, outline, 0.6)
         if plan is not None:
             return follow(op, goal, *plan)
-        if last:
-            return False
     return False
 
 
