@@ -363,6 +363,17 @@ class GraspSettings(BaseModel):
         description="Palm housing along the approach axis, behind the finger roots (m). "
         "robot/model.py (GRIPPER_BASE_LENGTH less the 1 cm coupling).",
     )
+    side_clearance: float = Field(
+        0.004,
+        ge=0,
+        lt=0.02,
+        description="Gap (m) kept between every seen point and the fingers' inner faces and"
+        " sides and the palm's sides: GPD's detector tests a hand this much larger on each"
+        " side, whose opening is this much narrower on each side; a vertical grasp needs the"
+        " object this much narrower than the opening on each side. A depth camera sees a box's"
+        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm;"
+        " with no gap a finger slid down an edge it had missed by 0.4 mm. Ours.",
+    )
     # GPD candidate generation (004 section 6.2; ten Pas et al. 2017 and GPD's defaults).
     gpd_samples: int = Field(
         500, ge=1, description="Points sampled from the target to seed candidates. GPD default."

@@ -12,7 +12,8 @@ the pads' centres, pad_depth / 2 behind the fingertips.
 Hand model (GraspSettings, mirroring description/dims): two fingers, each a box from the inner pad
 face (at +-width_max / 2 from the hand centre when open) outward by pad + plate thickness,
 finger_length deep along the approach and finger_width along the hand axis; behind the finger
-roots a palm box palm_width x palm_depth x palm_length.
+roots a palm box palm_width x palm_depth x palm_length. The detector tests that hand grown
+by side_clearance on its sides (cleared_hand), so a real hand clears what was seen.
 
 Speed: every (sample, orientation) pair is one "frame". Scene points are binned by their
 closing coordinate per frame (np.minimum.at), so each finger placement's deepest collision-free
@@ -769,6 +770,26 @@ def closing_region(
 # --- The detector ----------------------------------------------------------------------------
 
 
+def cleared_hand(s: GraspSettings) -> GraspSettings:
+    """The hand the detector tests: `s`'s grown by side_clearance on every side but the
+    fingertips and the palm's front (gpd_clearance keeps those off the first contact). Its
+    fingers' inner faces close in by the clearance, so a grasp's width is at most the stroke
+    less twice the clearance; its outer faces, the fingers' edges along the hand axis and
+    the palm's sides move out by it. The pads (the contacts) keep their size."""
+    m = s.side_clearance
+    if m == 0:
+        return s
+    return s.model_copy(
+        update={
+            "width_max": s.width_max - 2 * m,
+            "finger_thickness": s.finger_thickness + 2 * m,
+            "finger_width": max(s.finger_width, s.pad_width) + 2 * m,
+            "palm_width": s.palm_width + 2 * m,
+            "palm_depth": s.palm_depth + 2 * m,
+        }
+    )
+
+
 def hand_regions(s: GraspSettings) -> list[tuple[float, float, float]]:
     """Where scene points can touch a candidate hand, around its sample, as slab_pairs
     regions (half slab along the hand axis, radius in the rotation plane, largest u), m.
@@ -823,7 +844,7 @@ def detect_grasps(
     rng: np.random.Generator | None = None,
     timings: dict[str, float] | None = None,
 ) -> list[Grasp]:
-    """Grasp candidates on `target` that do not collide with `scene`.
+    """Grasp candidates on `target` that keep side_clearance from `scene` (cleared_hand).
 
     target: (M, 3) the segmented object's points in `base` (m); target_normals: (M, 3) their
     unit normals, pointing outward (toward the sensors). scene: (N, 3) the full cloud in
@@ -841,7 +862,7 @@ def detect_grasps(
             timings[stage] = now - clock[0]
         clock[0] = now
 
-    s = settings or get_settings().grasp
+    s = cleared_hand(settings or get_settings().grasp)
     rng = rng if rng is not None else np.random.default_rng(0)
     target = np.asarray(target, np.float64).reshape(-1, 3)
     if len(target) < 3:

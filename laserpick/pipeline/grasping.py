@@ -36,7 +36,6 @@ Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
 VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
 VERTICAL_TOP_POINTS = 30  #: top points needed to centre a vertical grasp on the top face
-VERTICAL_SLACK = 0.005  #: m of the stroke left over a vertical grasp's width
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready pose within this
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
@@ -73,7 +72,8 @@ def vertical_grasp(
     target: np.ndarray, support: float | None, settings: Settings
 ) -> Grasp | Failure:
     """A top-down grasp at the centroid, closing across the narrow side, the pads reaching
-    2 cm below the top but stopping 3 mm above the support surface at `support` (m).
+    2 cm below the top but stopping 3 mm above the support surface at `support` (m). The
+    object must leave the open fingers side_clearance on each side.
 
     The centroid is the top face's, when the cameras see enough of it: they look down on
     the object from the front, so the mean of all its points lies toward them.
@@ -86,7 +86,7 @@ def vertical_grasp(
     across = xy @ vecs[:, 0]
     # Robust extent: a few stray points (a shadow's edge, the table's rim) do not widen it.
     width = float(np.percentile(across, 99.5) - np.percentile(across, 0.5))
-    if width > settings.grasp.width_max - VERTICAL_SLACK:
+    if width > settings.grasp.width_max - 2 * settings.grasp.side_clearance:
         return Failure("detect_grasp", "The object is wider than the gripper opens.")
     approach = np.array([0.0, 0.0, -1.0])
     pose = np.eye(4)
