@@ -34,9 +34,10 @@ from laserpick.bench.protocols import (
     PROTOCOLS,
     UPRIGHT_TILT,
     Options,
-    _up_in_object,
     coin_flip_kitchen,
     jeeves_scene,
+    placed_tilt,
+    round_about_z,
     scan_points,
 )
 from laserpick.bench.report import markdown
@@ -45,6 +46,7 @@ from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
+from laserpick.robot.objects import LIBRARY
 from laserpick.robot.scenes import load_scene, scene_config
 from laserpick.transforms import invert, planar_pose, quat_from_matrix, rotx, rotz
 
@@ -267,15 +269,31 @@ def test_retries_at_one_object_count_as_one_task() -> None:
 
 
 def test_a_lying_object_set_down_turned_about_the_vertical_still_counts_as_upright():
-    """A can on its side, set down a quarter turn about the vertical (a place may turn it),
+    """A box on its side, set down a quarter turn about the vertical (a place may turn it),
     rests as it rested; tipped onto its end, it does not. The object's own z axis turned 90
     degrees in both, and the first counted as tipped over."""
+    tea_box = LIBRARY["tea_box"]
+    lying = quat_from_matrix(rotx(math.pi / 2))
+    assert not round_about_z(tea_box)
+    for turn in (math.pi / 2, math.pi):
+        turned = quat_from_matrix(rotz(turn) @ rotx(math.pi / 2))
+        assert placed_tilt(tea_box, lying, turned) < 1e-6
+    assert placed_tilt(tea_box, lying, quat_from_matrix(np.eye(3))) > UPRIGHT_TILT  # on its end
+    # Rolled 40 degrees about its x axis, which stays level: tipped.
+    rolled = quat_from_matrix(rotx(math.pi / 2 + math.radians(40)))
+    assert placed_tilt(tea_box, lying, rolled) == pytest.approx(math.radians(40))
+
+
+def test_a_can_that_rolls_on_its_side_is_not_tipped_but_one_stood_up_is():
+    """A can is round about its axis: rolled about it, it rests as it rested. Its axis
+    turned toward the vertical is a tilt; a mug (its handle off the axis) is not round."""
+    can = LIBRARY["soda_can"]
+    assert round_about_z(can) and not round_about_z(LIBRARY["mug"])
     lying = rotx(math.pi / 2)
-    before = _up_in_object(quat_from_matrix(lying))
-
-    def tilt(R: np.ndarray) -> float:
-        return math.acos(float(np.clip(before @ _up_in_object(quat_from_matrix(R)), -1, 1)))
-
-    assert tilt(rotz(math.pi / 2) @ lying) < 1e-6
-    assert tilt(rotz(math.pi) @ lying) < 1e-6
-    assert tilt(np.eye(3)) > UPRIGHT_TILT  # stood on its end
+    before = quat_from_matrix(lying)
+    rolled = quat_from_matrix(lying @ rotz(math.radians(37)))  # about its own axis
+    assert placed_tilt(can, before, rolled) < 1e-6
+    assert placed_tilt(can, before, quat_from_matrix(rotz(1.0) @ lying @ rotz(2.0))) < 1e-6
+    raised = quat_from_matrix(rotx(math.pi / 2 - math.radians(20)))  # axis 20 deg up
+    assert placed_tilt(can, before, raised) == pytest.approx(math.radians(20))
+    assert placed_tilt(can, before, quat_from_matrix(np.eye(3))) == pytest.approx(math.pi / 2)

@@ -53,7 +53,7 @@ from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.types import Failure
-from laserpick.robot.objects import LIBRARY, footprint_half_extents, rest_pose
+from laserpick.robot.objects import LIBRARY, ObjectModel, footprint_half_extents, rest_pose
 from laserpick.robot.scenes import (
     Scene,
     SceneError,
@@ -422,13 +422,38 @@ def _up_in_object(quat: np.ndarray) -> np.ndarray:
     return matrix_from_quat(quat).T @ np.array([0.0, 0.0, 1.0])
 
 
+def round_about_z(model: ObjectModel) -> bool:
+    """Whether `model` is a body of revolution about its frame's z axis: only cylinders,
+    capsules and spheres, centred on that axis, the cylinders and capsules along it."""
+    for part in model.parts:
+        if part.kind not in ("cylinder", "capsule", "sphere") or np.hypot(*part.pos[:2]) > 1e-6:
+            return False
+        if part.kind != "sphere" and abs(matrix_from_quat(np.array(part.quat))[2, 2]) < 1 - 1e-9:
+            return False
+    return True
+
+
+def placed_tilt(model: ObjectModel, before: np.ndarray, after: np.ndarray) -> float:
+    """How far (rad) an object of `model` was tipped between orientations `before` and
+    `after` (w, x, y, z): the angle between the world's up in its frame then and now. A
+    turn about the vertical is no tilt. Nor, for a body of revolution, is a roll about its
+    own axis, which leaves it looking as it was: a can set down on its side that rolls a
+    little rests as it rested. Its tilt is then the change in its axis' angle to the
+    vertical."""
+    up_before, up_after = _up_in_object(before), _up_in_object(after)
+    if round_about_z(model):
+        angles = np.arccos(np.clip([up_before[2], up_after[2]], -1.0, 1.0))
+        return float(abs(angles[1] - angles[0]))
+    return math.acos(float(np.clip(up_before @ up_after, -1.0, 1.0)))
+
+
 def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     """One 004 section 8.3 task: pick `rec.instance` and set it down on another surface."""
     session, referee = op.session, op.referee
     if not _go_to_object(op, scene, rec.instance):
         return rec.fail("precondition", "the user could not park in front of it")
     session.set_mode(op.actor, mode="pick_and_place")
-    up_before = _up_in_object(referee.world_quat(rec.instance))
+    quat_before = referee.world_quat(rec.instance)
     if not op.pick(rec) or rec.failure is not None:
         return rec
     if session.state != TaskState.AWAITING_PLACE:
@@ -461,8 +486,8 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
         return rec.fail(failure.kind, failure.message)
     op.robot.sleep(0.5)
     error = float(np.linalg.norm(referee.position(rec.instance)[:2] - placed.hit[:2] - offset))
-    up_now = _up_in_object(referee.world_quat(rec.instance))
-    tilt = math.acos(float(np.clip(up_before @ up_now, -1.0, 1.0)))
+    model = scene.placement(rec.instance).model
+    tilt = placed_tilt(model, quat_before, referee.world_quat(rec.instance))
     rec.surface = f"{here} -> {dest.name}"
     if tilt > UPRIGHT_TILT:
         return rec.fail("execute", f"set down tilted {math.degrees(tilt):.0f} deg")
