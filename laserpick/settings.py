@@ -374,6 +374,19 @@ class GraspSettings(BaseModel):
         " edge up to a few mm short of where it is, and the arm tracks its path to a few mm;"
         " with no gap a finger slid down an edge it had missed by 0.4 mm. Ours.",
     )
+    free_space_tolerance: float = Field(
+        0.006,
+        gt=0,
+        description="A depth reading shows a point free when it lies this far (m) beyond it:"
+        " about three times the sensors' noise at 1.2 m. Ours.",
+    )
+    free_space_share: float = Field(
+        0.9,
+        ge=0,
+        le=1,
+        description="Share of a grasp's finger probes the cameras must have seen free; 0 turns"
+        " the free-space test off. Ours (pipeline/free_space.py).",
+    )
     # GPD candidate generation (004 section 6.2; ten Pas et al. 2017 and GPD's defaults).
     gpd_samples: int = Field(
         500, ge=1, description="Points sampled from the target to seed candidates. GPD default."

@@ -23,6 +23,7 @@ import numpy as np
 
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_HIGH_READY_Q, UR5_READY_Q
 from laserpick.pipeline.collision import CollisionChecker, mirrored_back
+from laserpick.pipeline.free_space import fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
@@ -109,7 +110,9 @@ def candidates(
     complete: bool = False,
 ) -> list[Grasp] | Failure:
     """Raw grasp candidates on the perceived target. complete: for "gpd", add the target's
-    back as `mirrored_back` guesses it (to the target and to the obstacles)."""
+    back as `mirrored_back` guesses it (to the target and to the obstacles). GPD's are only
+    those whose fingers go where the cameras saw free space (`fingers_seen_free`): its
+    collision test knows only the seen surfaces."""
     cloud, seg = perception.cloud, perception.segmentation
     assert seg is not None
     target = cloud.points[seg.indices].astype(np.float64)
@@ -119,7 +122,9 @@ def candidates(
             back, back_normals = mirrored_back(target, normals)
             target, normals = np.vstack([target, back]), np.vstack([normals, back_normals])
             scene = np.vstack([scene, back])
-        return detect_grasps(target, normals, scene, settings.grasp, rng=rng)
+        found = detect_grasps(target, normals, scene, settings.grasp, rng=rng)
+        seen = fingers_seen_free(found, perception.frames, settings.grasp)
+        return [g for g, ok in zip(found, seen, strict=True) if ok]
     support = seg.surface.height if seg.surface is not None else None
     if strategy == "overhead":
         floor = support if support is not None else float(target[:, 2].min())

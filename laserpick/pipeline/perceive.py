@@ -29,6 +29,8 @@ class Perception:
 
     timings: seconds per stage, in order: "fuse", "detect_laser", "segment".
     failure: set when a stage failed; later stages did not run and their fields are None.
+    frames: the depth frames the cloud was fused from: where the cameras saw past a point,
+    the space there is free (the grasp filter's free-space test); empty when not at hand.
     """
 
     cloud: FusedCloud
@@ -36,6 +38,7 @@ class Perception:
     segmentation: Segmentation | None
     failure: Failure | None
     timings: dict[str, float] = field(default_factory=dict)
+    frames: tuple[DepthFrame, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -73,6 +76,7 @@ def perceive(
     """
     s = settings or get_settings().perception
     timings: dict[str, float] = {}
+    frames = tuple(frames)
     if cloud is None:
         cloud = _timed(timings, "fuse", lambda: fuse(frames, s))
     else:
@@ -83,8 +87,8 @@ def perceive(
         lambda: direct_mark(point, s) if point is not None else detect_mark(frames, s),
     )
     if isinstance(mark, Failure):
-        return Perception(cloud, None, None, mark, timings)
+        return Perception(cloud, None, None, mark, timings, frames)
     seg = _timed(timings, "segment", lambda: segment_target(cloud, mark.point, s, method=method))
     if isinstance(seg, Failure):
-        return Perception(cloud, mark, None, seg, timings)
-    return Perception(cloud, mark, seg, None, timings)
+        return Perception(cloud, mark, None, seg, timings, frames)
+    return Perception(cloud, mark, seg, None, timings, frames)

@@ -1,0 +1,78 @@
+"""Free space as the depth cameras saw it: a finger may go only where a camera saw past it.
+
+A fused cloud holds the surfaces the cameras saw, not the space behind them. An object seen
+from the front shows its front; a grasp detector that tests the hand against those points
+only may put a finger down into the object's unseen back (a cereal box standing on a shelf,
+its back guessed too thin, stopped the hand on its way in). The cameras say more than the
+points: along each pixel's ray, space is free up to the depth it read. A point is seen free
+when some camera's reading at its pixel lies beyond it.
+
+Frames: points in `base` (m); each DepthFrame carries its pose in `base` and its intrinsics.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from laserpick.pipeline.types import DepthFrame, Grasp
+from laserpick.settings import GraspSettings
+
+#: Where the free-space test probes each finger, as fractions: across its width (hand axis,
+#: of finger_width / 2 either side of its middle) and down its length (of finger_length,
+#: from the tip). Its middle along the closing axis: the pad and plate's middle.
+PROBE_ACROSS = (-0.6, 0.0, 0.6)
+PROBE_DOWN = (0.15, 0.5, 0.85)
+#: Nearest a probe may be to a camera (m) to count: the sensors' minimum range.
+MIN_RANGE = 0.1
+
+
+def seen_free(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -> np.ndarray:
+    """(N,) bool: whether some camera saw past each point (N, 3) (m, `base`), its reading at
+    the point's pixel more than `tolerance` (m) beyond the point's own depth. A pixel that
+    read nothing (0) shows nothing: nothing was seen there, near or far."""
+    points = np.asarray(points, np.float64).reshape(-1, 3)
+    free = np.zeros(len(points), bool)
+    for f in frames:
+        R, t = f.T_base_cam[:3, :3], f.T_base_cam[:3, 3]
+        cam = (points - t) @ R  # into the optical frame: x right, y down, z forward
+        z = cam[:, 2]
+        ahead = z > MIN_RANGE
+        zs = np.where(ahead, z, 1.0)
+        u = np.rint(f.K[0, 0] * cam[:, 0] / zs + f.K[0, 2]).astype(np.int64)
+        v = np.rint(f.K[1, 1] * cam[:, 1] / zs + f.K[1, 2]).astype(np.int64)
+        h, w = f.depth.shape
+        i = np.flatnonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
+        reading = f.depth[v[i], u[i]]
+        free[i[reading > z[i] + tolerance]] = True
+    return free
+
+
+def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:
+    """(G, P, 3) points (m, `base`) inside the open fingers of the hands at TCP `poses`
+    (G, 4, 4): PROBE_ACROSS x PROBE_DOWN in each finger's middle, both fingers."""
+    poses = np.asarray(poses, np.float64).reshape(-1, 4, 4)
+    c = s.width_max / 2 + (s.pad_thickness + s.finger_thickness) / 2
+    tip = s.pad_depth / 2  # the TCP lies this far behind the fingertips
+    local = np.array(
+        [
+            (x * s.finger_width / 2, side * c, tip - d * s.finger_length)
+            for side in (-1.0, 1.0)
+            for x in PROBE_ACROSS
+            for d in PROBE_DOWN
+        ]
+    )
+    return np.einsum("gij,pj->gpi", poses[:, :3, :3], local) + poses[:, None, :3, 3]
+
+
+def fingers_seen_free(
+    grasps: Sequence[Grasp], frames: Sequence[DepthFrame], s: GraspSettings
+) -> np.ndarray:
+    """(G,) bool: whether the cameras saw free space at enough (free_space_share) of each
+    grasp's finger probes. True for all when there are no frames to ask."""
+    if not frames or not grasps:
+        return np.ones(len(grasps), bool)
+    probes = finger_probes(np.array([g.pose for g in grasps]), s)
+    free = seen_free(probes.reshape(-1, 3), frames, s.free_space_tolerance)
+    return free.reshape(len(grasps), -1).mean(axis=1) >= s.free_space_share
