@@ -307,7 +307,8 @@ class Behaviours:
         support = lowest if grasps.support is None else min(grasps.support, lowest)
         pts = carried_shape(grasps.target, support)
         pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
-        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, grasps.surroundings)
+        around = self._without_leftovers(grasps.surroundings, grasps.target, support)
+        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, around)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)
@@ -409,7 +410,10 @@ class Behaviours:
     def _rise_clear(self, held: Held) -> Failure | None:
         """Lift straight up, 5 cm at a time and at most RISE_MAX, until the held object is
         clear of the surroundings: just after the lift it may still be near its neighbours
-        or the parts of itself the segmentation missed, and a planner cannot start there."""
+        or the parts of itself the segmentation missed, and a planner cannot start there.
+        A step that would bring the arm itself near anything is not taken: a hand held out
+        level and raised swings the elbow back over the scooter, into the tiller and the
+        sensor posts, and no path leaves from there."""
         s = self.settings.motion
         risen = 0.0
         while not held.surroundings.clearance_ok(self._q(), payload=held.points_tcp)[0]:
@@ -418,7 +422,7 @@ class Behaviours:
             T = tcp_pose(self._q())
             T[2, 3] += 0.05
             path = cartesian_line(self._q(), T, s.cartesian_step)
-            if path is None:
+            if path is None or not held.surroundings.clearance_ok(path).all():
                 return None
             failure = self._run(timed(path, s, tcp_speed=s.approach_speed), "lifting clear")
             if failure is not None:
@@ -597,6 +601,23 @@ class Behaviours:
         if not reached:
             return Failure("ik_plan", "The arm cannot reach above that spot.")
         return Failure("ik_plan", "The arm cannot lower the object there.")
+
+    @staticmethod
+    def _without_leftovers(
+        surroundings: CollisionChecker, target: np.ndarray, support: float
+    ) -> CollisionChecker:
+        """`surroundings` less the points above the support surface (at `support`, m) within
+        CARRIED_PADDING of the target's seen points (`base`): parts of the object the
+        segmentation left out (a spray bottle's trigger head), which leave with it. Kept,
+        they stood where the lifted object now hangs, and no carry could start."""
+        pts = surroundings.points
+        if len(pts) == 0 or len(target) == 0:
+            return surroundings
+        d, _ = cKDTree(target).query(pts, distance_upper_bound=CARRIED_PADDING)
+        leftover = np.isfinite(d) & (pts[:, 2] > support + CARRIED_PADDING)
+        if not leftover.any():
+            return surroundings
+        return CollisionChecker(pts[~leftover], margin=surroundings.margin, filtered=True)
 
     @staticmethod
     def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:

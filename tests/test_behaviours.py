@@ -216,6 +216,50 @@ def test_a_held_object_still_touching_its_surroundings_is_raised_before_the_tuck
     assert robot.gripper_state().holding
 
 
+def test_a_rise_stops_before_the_arm_comes_near_anything(robot):
+    """Rising clear of what the held object touches must not bring the arm itself near
+    something else: a level hand raised swung its elbow back into the tiller and the sensor
+    posts, and no carry could leave from there. The surroundings here (a stand-in checker)
+    always block the held object, and block the arm 8 cm above where the hand is: one 5 cm
+    step is taken, not a second."""
+    b, _ = _pick(robot, "mug_1")
+    assert b.held is not None
+    z0 = tcp_pose(robot.joint_state().q)[2, 3]
+
+    class Surroundings(CollisionChecker):
+        def clearance_ok(self, Q, *, payload=None, **kw):
+            z = tcp_pose(np.atleast_2d(Q))[:, 2, 3]
+            return np.zeros(len(z), bool) if payload is not None else z < z0 + 0.08
+
+    b.held.surroundings = Surroundings(np.zeros((0, 3)))
+    rises: list[np.ndarray] = []
+    run = b._run
+
+    def recording(traj: Trajectory, what: str):
+        if what == "lifting clear":
+            rises.append(traj.q)
+        return run(traj, what)
+
+    b._run = recording  # type: ignore[method-assign]
+    assert b._rise_clear(b.held) is None
+    assert len(rises) == 1, "one step, not the one that brings the arm near something"
+    assert tcp_pose(robot.joint_state().q)[2, 3] - z0 == pytest.approx(0.05, abs=0.01)
+
+
+def test_parts_of_the_object_the_segmentation_missed_leave_with_it():
+    """Points beside the picked target, above its support, are parts of it the segmentation
+    left out; they are not obstacles for the carry. The support and farther objects are."""
+    target = np.array([[1.5, -0.3, z] for z in np.arange(0.47, 0.70, 0.01)])
+    trigger = np.array([[1.52, -0.3, 0.68], [1.51, -0.29, 0.69]])  # within 3 cm of its top
+    table = np.array([[1.5 + dx, -0.3, 0.46] for dx in (-0.02, 0.0, 0.02)])
+    neighbour = np.array([[1.5, -0.2, 0.55]])  # 10 cm away
+    around = CollisionChecker(np.vstack([trigger, table, neighbour]), voxel=0.0)
+    kept = Behaviours._without_leftovers(around, target, support=0.46).points
+    assert {tuple(p) for p in np.round(kept, 3)} == {
+        tuple(p) for p in np.round(np.vstack([table, neighbour]), 3)
+    }
+
+
 def test_place_on_a_non_surface_is_refused_and_keeps_the_object(robot):
     b, _ = _pick(robot, "mug_1")
     out = b.place(fuse(robot.capture()), np.array([1.5, -0.3, 1.2]))  # mid-air
