@@ -99,3 +99,19 @@ def pinhole_intrinsics(width: int, height: int, fovy: float) -> np.ndarray:
     """
     f = (height / 2.0) / math.tan(fovy / 2.0)
     return np.array([[f, 0.0, (width - 1) / 2.0], [0.0, f, (height - 1) / 2.0], [0.0, 0.0, 1.0]])
+
+
+def pinhole_project(
+    points: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray, near: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pixel coordinates (N, 2) (u, v), depths along the optical axis (N,) (m) and a mask of
+    the points in front of the lens (depth > `near`, m) of `points` (N, 3) in the frame
+    `T_world_cam` (4x4, OpenCV optical frame: x right, y down, z forward) is given in. The
+    pixel coordinates of the points not in front are meaningless."""
+    P = np.asarray(points, dtype=float).reshape(-1, 3)
+    R, t = T_world_cam[:3, :3], T_world_cam[:3, 3]
+    q = (P - t) @ R  # R^T (p - t) per row: the points in the optical frame
+    front = q[:, 2] > near
+    z = np.where(front, q[:, 2], 1.0)
+    uv = np.stack([K[0, 0] * q[:, 0] / z + K[0, 2], K[1, 1] * q[:, 1] / z + K[1, 2]], axis=1)
+    return uv, q[:, 2], front

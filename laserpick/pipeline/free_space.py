@@ -18,6 +18,7 @@ import numpy as np
 
 from laserpick.pipeline.types import DepthFrame, Grasp
 from laserpick.settings import GraspSettings
+from laserpick.transforms import pinhole_project
 
 #: Where the free-space test probes each finger, as fractions: across its width (hand axis,
 #: of finger_width / 2 either side of its middle) and down its length (of finger_length,
@@ -35,13 +36,8 @@ def seen_free(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float
     points = np.asarray(points, np.float64).reshape(-1, 3)
     free = np.zeros(len(points), bool)
     for f in frames:
-        R, t = f.T_base_cam[:3, :3], f.T_base_cam[:3, 3]
-        cam = (points - t) @ R  # into the optical frame: x right, y down, z forward
-        z = cam[:, 2]
-        ahead = z > MIN_RANGE
-        zs = np.where(ahead, z, 1.0)
-        u = np.rint(f.K[0, 0] * cam[:, 0] / zs + f.K[0, 2]).astype(np.int64)
-        v = np.rint(f.K[1, 1] * cam[:, 1] / zs + f.K[1, 2]).astype(np.int64)
+        uv, z, ahead = pinhole_project(points, f.K, f.T_base_cam, MIN_RANGE)
+        u, v = np.rint(uv).astype(np.int64).T
         h, w = f.depth.shape
         i = np.flatnonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
         reading = f.depth[v[i], u[i]]

@@ -51,6 +51,7 @@ from scipy.cluster.hierarchy import fcluster, linkage
 
 from laserpick.pipeline.types import DepthFrame, Failure, LaserMark
 from laserpick.settings import PerceptionSettings, get_settings
+from laserpick.transforms import pinhole_project
 
 KIND = "detect_laser"
 #: Fewest valid depths a window must hold before its median is trusted.
@@ -188,15 +189,13 @@ class _View:
         behind it, and a view must still vouch for the rim."""
         if len(self.uv) == 0:
             return False, False
-        T = self.frame.T_base_cam
-        q = T[:3, :3].T @ (point - T[:3, 3])
-        if q[2] <= 0:
+        uvs, z, front = pinhole_project(point, self.frame.K, self.frame.T_base_cam, 0.0)
+        if not front[0]:
             return False, False
-        K = self.frame.K
-        uv = np.array([K[0, 0] * q[0] / q[2] + K[0, 2], K[1, 1] * q[1] / q[2] + K[1, 2]])
+        uv = uvs[0]
         d = np.hypot(*(self.uv - uv).T)
         i = int(np.argmin(d))
-        if d[i] > tol_px or not self._depth_allows(uv, float(q[2])):
+        if d[i] > tol_px or not self._depth_allows(uv, float(z[0])):
             return False, False
         return True, bool(self.in_pair[i])
 

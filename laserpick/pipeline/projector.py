@@ -17,6 +17,8 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
+from laserpick.transforms import pinhole_project
+
 #: Nearer than this (m) along the optical axis a point is not drawn: it is behind the lens or
 #: too close to light meaningfully.
 NEAR = 0.05
@@ -58,15 +60,7 @@ class Projector:
     def project(self, points_base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixel coordinates (N, 2) (u, v) of `points_base` (N, 3) m, and a mask of the points
         in front of the lens (z > NEAR m); coordinates of the others are meaningless."""
-        P = np.asarray(points_base, dtype=float).reshape(-1, 3)
-        R, t = self.T_base_proj[:3, :3], self.T_base_proj[:3, 3]
-        q = (P - t) @ R  # R^T (p - t) per row: the points in the projector's optical frame
-        front = q[:, 2] > NEAR
-        z = np.where(front, q[:, 2], 1.0)
-        uv = np.stack(
-            [self.K[0, 0] * q[:, 0] / z + self.K[0, 2], self.K[1, 1] * q[:, 1] / z + self.K[1, 2]],
-            axis=1,
-        )
+        uv, _, front = pinhole_project(points_base, self.K, self.T_base_proj, NEAR)
         return uv, front
 
 
