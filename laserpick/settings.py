@@ -397,6 +397,13 @@ class GraspSettings(BaseModel):
     gpd_finger_placements: int = Field(
         10, ge=1, description="Lateral hand offsets along the closing axis per rotation. GPD."
     )
+    gpd_tilts_deg: tuple[float, ...] = Field(
+        (-60.0, -30.0, 30.0, 60.0),
+        description="Tilts (deg) of the hand about its closing axis, leaning the approach toward"
+        " the curvature axis, tried when no untilted grasp is reachable: a low object lying"
+        " pointed at the robot under a shelf's board is then taken from the front and above,"
+        " across its girth. GPD 2's extra hand axes; ours for the angles.",
+    )
     gpd_nn_radius: float = Field(
         0.01,
         gt=0,
@@ -487,6 +494,12 @@ class MotionSettings(BaseModel):
         0.02, ge=0, description="Lift (m) before closing again: the re-grip of 002."
     )
     lift: float = Field(0.10, gt=0, description="Lift (m) after the grasp. 000 section 4.6.")
+    lift_low: float = Field(
+        0.05,
+        gt=0,
+        description="Lift (m) after the grasp where the full `lift` is blocked, as under a"
+        " shelf's board: enough to take the object off its support. Ours.",
+    )
     guard_force: float = Field(
         25.0,
         gt=0,

@@ -20,6 +20,7 @@ from laserpick.bench.operator import (
     PARK_FLOOR_REACH,
     Footprint,
     Outline,
+    Referee,
     _at,
     _clearance,
     _leg,
@@ -238,6 +239,28 @@ def test_scan_points_step_across_the_visible_top() -> None:
     assert np.ptp(pts[:, 2]) < 0.025  # all on the top
     nearest = np.linalg.norm(pts[:, None] - seen[None], axis=2).min(axis=1)
     assert nearest.max() < 1e-6  # each is a point the cameras saw on the object
+
+
+def test_the_user_sees_whether_the_dot_is_on_the_object() -> None:
+    """What the scripted user re-aims by: the dot aimed at an object's visible top lies on
+    it; aimed beside it, onto the table, it does not."""
+    cap = capture("isolation", seed=1)
+    try:
+        referee = Referee(cap.robot)
+        name = next(p.instance for p in cap.scene.placements if p.model.name == "mug")
+        top = cap.visible_top(fuse(cap.frames), name)
+        assert top is not None
+        laser = cap.robot.laser
+        laser.aim_at(top)
+        assert referee.dot_on(name)
+        beam = (top - laser.origin_base)[:2] / np.linalg.norm((top - laser.origin_base)[:2])
+        beside = top + 0.15 * np.r_[-beam[1], beam[0], 0.0]  # 15 cm to its left
+        laser.aim_at(beside)
+        assert not referee.dot_on(name)
+        hit = cap.robot.laser_hits()
+        assert hit, "the dot aimed beside the mug lies on the table"
+    finally:
+        cap.close()
 
 
 def test_retries_at_one_object_count_as_one_task() -> None:

@@ -169,6 +169,47 @@ def test_cylinder_gets_top_and_side_grasps(cylinder_grasps):
     assert (np.abs(approach_z) < 0.3).sum() >= 3  # from the side
 
 
+def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():
+    rng = np.random.default_rng(4)
+    normal = rng.normal(size=(5, 3))
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    axis = np.cross(normal, rng.normal(size=(5, 3)))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    tilts = np.radians([0.0, 30.0, -60.0])
+    n2, a2 = gd.tilted_frames(normal, axis, tilts)
+    assert n2.shape == a2.shape == (15, 3)
+    for t, beta in enumerate(tilts):
+        rows = slice(5 * t, 5 * t + 5)
+        assert np.allclose(np.cross(n2[rows], a2[rows]), np.cross(normal, axis))  # closing
+        assert np.allclose(np.sum(n2[rows] * normal, axis=1), math.cos(beta))
+        assert np.allclose(np.sum(n2[rows] * axis, axis=1), math.sin(beta))
+
+
+def test_a_lying_cylinder_is_grasped_across_its_girth_from_along_its_axis_only_tilted():
+    """A can lying along x: GPD's frames (hand axis along the can) approach it square to its
+    axis; tilted about the closing axis, the hand also comes in along it, from the front and
+    above, still closing across the girth."""
+    r = 0.022
+    pts, n = cylinder(r=r, height=0.10)
+    # Lay it down along x: (x, y, z) -> (z - 5 cm, y, r - x), on the table.
+    turn = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+    pts = pts @ turn.T + [-0.05, 0.0, r]
+    n = n @ turn.T
+    upright = detect(pts, n)
+    assert upright and max(abs(g.approach[0]) for g in upright) < 0.35
+    scene = np.vstack([table(), pts]).astype(np.float32)
+    tilts = tuple(np.radians(S.gpd_tilts_deg))
+    tilted = detect_grasps(
+        pts.astype(np.float32), noisy(n), scene, S, np.random.default_rng(0), tilts=tilts
+    )
+    leaning = [g for g in tilted if abs(g.approach[0]) > 0.45]
+    assert len(leaning) >= 3
+    for g in leaning:
+        assert abs(g.closing[0]) < math.sin(FRICTION + math.radians(3))  # across the girth
+        assert g.width == pytest.approx(2 * r, abs=0.006)
+        assert not in_fingers(g, table()).any() and finger_corners(g)[:, 2].min() > 0.0
+
+
 # --- boxes ---------------------------------------------------------------------------------
 
 

@@ -22,7 +22,14 @@ from laserpick.pipeline.collision import (
     sphere_centres,
     thin,
 )
-from laserpick.pipeline.plan import cartesian_line, joint_path, plan_pick, rrt_connect, shortcut
+from laserpick.pipeline.plan import (
+    cartesian_line,
+    joint_path,
+    plan_pick,
+    rrt_connect,
+    shortcut,
+    straight_lift,
+)
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.model import ModelInfo, build_sim_model
@@ -286,6 +293,33 @@ def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
     tcp = tcp_pose(plan.approach.q)[:, :3, 3]
     v = np.linalg.norm(np.diff(tcp, axis=0), axis=1) / np.diff(plan.approach.times)
     assert v.max() <= s.approach_speed * 1.05
+
+
+def test_under_a_board_the_lift_is_the_low_one_and_under_a_lower_one_none():
+    """A board above the arm that the full lift would reach leaves the low lift; one that
+    even the low lift would reach leaves none."""
+    s = get_settings().motion
+    T = top_grasp(1.55, -0.25, 0.70)
+    q = ik_tcp(T, dims.UR5_READY_Q)[0]
+    full = straight_lift(q, T, CollisionChecker(EMPTY), s)
+    assert full is not None
+    # The board is a patch above the hand, 20 cm across: over the wrist, not the elbow.
+    centres = sphere_centres(body_frames(full))
+    over = np.all(np.abs(centres[0, :, :2] - T[:2, 3]) < 0.1 + SPHERES.radius[:, None], axis=1)
+    arm = ~SPHERES.hand & over
+    rise = tcp_pose(full)[:, 2, 3] - T[2, 3]
+    tops = (centres[:, arm, 2] + SPHERES.radius[arm]).max(axis=1)
+    top_low = float(tops[rise <= s.lift_low + 1e-9].max())
+    assert tops.max() > top_low + 0.02  # the full lift rises higher
+
+    def lifted(board_z: float) -> float | None:
+        board = table(z=board_z, x=(T[0, 3] - 0.1, T[0, 3] + 0.1), y=(T[1, 3] - 0.1, T[1, 3] + 0.1))
+        lift = straight_lift(q, T, CollisionChecker(board, margin=s.clearance), s)
+        return None if lift is None else float(tcp_pose(lift[-1])[2, 3] - T[2, 3])
+
+    assert lifted(float(tops.max()) + s.clearance + 0.01) == pytest.approx(s.lift, abs=1e-6)
+    assert lifted(top_low + s.clearance + 0.005) == pytest.approx(s.lift_low, abs=1e-6)
+    assert lifted(float(tops[0]) + s.clearance + 0.005) is None
 
 
 def test_plan_pick_refuses_a_grasp_under_the_table():

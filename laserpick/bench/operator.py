@@ -92,6 +92,13 @@ class Referee:
         self.robot.sim.call(move)
         self.robot.sleep(0.1)  # headless, the call lands at the next step: take it now
 
+    def dot_on(self, instance: str) -> bool:
+        """Whether the aiming beam's dot lies on `instance` now: what the user sees."""
+        m = self.robot.model
+        hits = self.robot.laser.cast_hits(m, self._posed())
+        body = self.robot.sim.info.object_bodies[instance]
+        return bool(hits) and hits[0] is not None and int(m.geom_bodyid[hits[0].geom]) == body
+
     def to_base(self, world: np.ndarray) -> np.ndarray:
         """A `world` point (m) in `base` now."""
         return (self._T_base_world() @ np.append(world, 1.0))[:3]

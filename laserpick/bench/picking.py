@@ -32,6 +32,10 @@ BENCH = Actor("bench")
 #: Marks the operator makes again after the mark itself failed (the dots missed, or no object
 #: under them), as 004's users re-aimed.
 REMARKS = 2
+#: Times the operator aims before confirming, until the dot they see lies on the object. A
+#: dot that grazed past a low object's top onto the wall behind is seen and re-aimed; 004's
+#: users confirmed once the dot was on the object.
+AIMS = 5
 #: Longest a session job may take (s of wall time) before the run is declared hung.
 JOB_TIMEOUT = 600.0
 #: The session's progress messages at the moment the hand lets go of the object.
@@ -131,11 +135,15 @@ class ScriptedOperator:
     def _events_since(self, k: int, name: str) -> list[dict[str, Any]]:
         return [e for e in self._events[k:] if e.get("name") == name]
 
-    def aim(self, point: np.ndarray) -> None:
-        """Aim the laser at `point` (m, `base`), off by the hand's tremor."""
-        self.session.aim_at(BENCH, point, "base")
-        dyaw, dpitch = self.rng.normal(0.0, self.tremor, 2)
-        self.session.nudge(BENCH, float(dyaw), float(dpitch))
+    def aim(self, point: np.ndarray, on: str | None = None) -> None:
+        """Aim the laser at `point` (m, `base`), off by the hand's tremor. on: an object the
+        user looks for the dot on; until it lies there, they aim again (up to AIMS times)."""
+        for _ in range(AIMS):
+            self.session.aim_at(BENCH, point, "base")
+            dyaw, dpitch = self.rng.normal(0.0, self.tremor, 2)
+            self.session.nudge(BENCH, float(dyaw), float(dpitch))
+            if on is None or self.referee.dot_on(on):
+                return
 
     def drive(self, v: float, w: float) -> None:
         """Hold the drive command (m/s, rad/s) for 0.1 s of robot time: a joystick."""
@@ -174,7 +182,7 @@ class ScriptedOperator:
             return False
         for _ in range(REMARKS + 1):
             rec.marks += 1
-            self.aim(aim)
+            self.aim(aim, on=rec.instance)
             k = len(self._events)
             s.confirm(BENCH)
             self.wait()

@@ -104,6 +104,17 @@ def local_frames(
     return normal, axis
 
 
+def tilted_frames(
+    normal: np.ndarray, axis: np.ndarray, tilts: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each frame (normal, curvature axis; (S, 3) each) turned about its closing axis,
+    normal x axis, by each of `tilts` (T,) rad: (T * S, 3) each, tilt-major. The hand's
+    approach at rotation 0 then leans from -normal toward the curvature axis, as GPD 2 tries
+    hand axes other than the curvature axis."""
+    c, s = np.cos(tilts)[:, None, None], np.sin(tilts)[:, None, None]
+    return (c * normal + s * axis).reshape(-1, 3), (c * axis - s * normal).reshape(-1, 3)
+
+
 def orientation_angles(n: int) -> np.ndarray:
     """Hand rotations (rad) about the curvature axis, -90 deg to +90 deg inclusive.
 
@@ -843,6 +854,7 @@ def detect_grasps(
     settings: GraspSettings | None = None,
     rng: np.random.Generator | None = None,
     timings: dict[str, float] | None = None,
+    tilts: tuple[float, ...] = (0.0,),
 ) -> list[Grasp]:
     """Grasp candidates on `target` that keep side_clearance from `scene` (cleared_hand).
 
@@ -852,6 +864,8 @@ def detect_grasps(
     the sampling: the same seed gives the same grasps. Returns grasps with pose (TCP in
     `base`; columns hand axis, closing axis, approach) and width (m), in sample order.
     timings, if given, receives the seconds spent in each stage (bench/grasp_detect_speed.py).
+    tilts (rad): each sample's frame is tried turned about its closing axis by each of these
+    (`tilted_frames`); the default, no tilt, is GPD's.
     """
     t_start = time.perf_counter()
     clock = [t_start]
@@ -876,6 +890,9 @@ def detect_grasps(
     idx = sample_indices(len(tgt), s.gpd_samples, rng)
     samples = tgt[idx]
     normal, axis = local_frames(tgt, normals, idx, s, tree)
+    if tilts != (0.0,):
+        normal, axis = tilted_frames(normal, axis, np.asarray(tilts, np.float64))
+        samples = np.tile(samples, (len(tilts), 1))
     angles = orientation_angles(s.gpd_orientations)
     grid = ClosingGrid(s)
     lap("frames")
@@ -883,12 +900,12 @@ def detect_grasps(
     # The pads' contents: target points where the pads could be. Most frames cannot pass the
     # antipodal test whatever the hand's depth and offset: they need no collision test.
     tsid, tu, tv, nu, nv = pad_pairs(tgt, normals, samples, normal, axis, s)
-    possible = antipodal_possible(tu, tv, nu, nv, tsid, len(idx), angles, grid, s)
+    possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, s)
     live = np.flatnonzero(possible.any(axis=1))
     lap("pad_pairs")
 
     # Collisions and depth, for those frames: scene points where the hand could be.
-    tips = np.full((len(idx), len(angles), len(grid.offsets)), -np.inf, np.float32)
+    tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
     if len(live):
         regions = hand_regions(s)
         cloud = collision_cloud(scene, centre, tgt, tree, regions, s)
@@ -898,13 +915,13 @@ def detect_grasps(
         tips[live] = pruned_tips(
             pairs, samples[live], normal[live], axis[live], angles, grid, s, regions, possible[live]
         )
-    tips = tips.reshape(len(idx) * len(angles), -1)
+    tips = tips.reshape(len(samples) * len(angles), -1)
     has, k = middle_placement(np.isfinite(tips))
     offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
     tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
     lap("deepest_tips")
 
-    keep = np.flatnonzero(has.reshape(len(idx), len(angles)).any(axis=1).take(tsid))
+    keep = np.flatnonzero(has.reshape(len(samples), len(angles)).any(axis=1).take(tsid))
     tu, tv, nu, nv, tsid = (x.take(keep) for x in (tu, tv, nu, nv, tsid))
     width, ok = closing_region(tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s)
     lap("closing_region")

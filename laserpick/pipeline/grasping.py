@@ -3,7 +3,8 @@ three strategies:
 
 - "gpd": GPD-style 6-DOF candidates on the target, checked against the whole cloud (004);
   when none of them is reachable, again on the target with its unseen back filled in by
-  symmetry; when still none is, the "vertical" grasp instead.
+  symmetry; when still none is, again with the hand tilted about its closing axis; when
+  still none is, the "vertical" grasp instead.
 - "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
 - "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
   takes once its base has centred the object (003 section IV).
@@ -108,11 +109,13 @@ def candidates(
     rng: np.random.Generator,
     *,
     complete: bool = False,
+    tilted: bool = False,
 ) -> list[Grasp] | Failure:
     """Raw grasp candidates on the perceived target. complete: for "gpd", add the target's
-    back as `mirrored_back` guesses it (to the target and to the obstacles). GPD's are only
-    those whose fingers go where the cameras saw free space (`fingers_seen_free`): its
-    collision test knows only the seen surfaces."""
+    back as `mirrored_back` guesses it (to the target and to the obstacles). tilted: for
+    "gpd", the hand tilted about its closing axis by `gpd_tilts_deg` instead of untilted.
+    GPD's are only those whose fingers go where the cameras saw free space
+    (`fingers_seen_free`): its collision test knows only the seen surfaces."""
     cloud, seg = perception.cloud, perception.segmentation
     assert seg is not None
     target = cloud.points[seg.indices].astype(np.float64)
@@ -122,7 +125,8 @@ def candidates(
             back, back_normals = mirrored_back(target, normals)
             target, normals = np.vstack([target, back]), np.vstack([normals, back_normals])
             scene = np.vstack([scene, back])
-        found = detect_grasps(target, normals, scene, settings.grasp, rng=rng)
+        tilts = tuple(np.radians(settings.grasp.gpd_tilts_deg)) if tilted else (0.0,)
+        found = detect_grasps(target, normals, scene, settings.grasp, rng=rng, tilts=tilts)
         seen = fingers_seen_free(found, perception.frames, settings.grasp)
         return [g for g, ok in zip(found, seen, strict=True) if ok]
     support = seg.surface.height if seg.surface is not None else None
@@ -170,11 +174,13 @@ def find_grasps(
     checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
 
-    def add(kind: Strategy, complete: bool = False, most: int | None = None) -> bool:
+    def add(
+        kind: Strategy, complete: bool = False, tilted: bool = False, most: int | None = None
+    ) -> bool:
         """Detect `kind` candidates and filter them (at most `most`, evenly sampled) into
         `checked`, timed. False when the detection failed."""
         t0 = time.perf_counter()
-        more = candidates(perception, kind, s, rng, complete=complete)
+        more = candidates(perception, kind, s, rng, complete=complete, tilted=tilted)
         timings["detect"] += time.perf_counter() - t0
         if isinstance(more, Failure):
             return False
@@ -191,6 +197,11 @@ def find_grasps(
         # A whole object offers many more grasps (800 on a ball) than its seen part, and
         # the filter's time grows with them: an even sample of them is filtered.
         add("gpd", complete=True, most=COMPLETED_MAX)
+    if strategy == "gpd" and s.grasp.gpd_tilts_deg and not any(g.ik is not None for g in checked):
+        # Under a shelf's board a low object lying pointed at the robot offers only grasps
+        # from above, across its girth, and the wrist does not fit above it; from the front
+        # and above, with the hand tilted about its closing axis, it does.
+        add("gpd", complete=True, tilted=True, most=COMPLETED_MAX)
     # A low, a round or a near object may still offer no reachable candidate, or no room
     # for the hand toward them. The centroid top grasp (Jeeves') is then the fallback.
     if strategy == "gpd" and not any(g.ik is not None for g in checked) and add("vertical"):

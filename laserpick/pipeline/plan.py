@@ -238,6 +238,21 @@ class PickPlan:
     q_lifted: np.ndarray
 
 
+def straight_lift(
+    q_from: np.ndarray, T_grasp: np.ndarray, surroundings: CollisionChecker, s: MotionSettings
+) -> np.ndarray | None:
+    """The straight lift from q_from to `lift` above the grasp pose T_grasp, or to `lift_low`
+    where the full lift is blocked (a shelf's board above): joint waypoints, or None if
+    neither is clear of the surroundings for the arm."""
+    for height in (s.lift, min(s.lift_low, s.lift)):
+        T_lift = T_grasp.copy()
+        T_lift[2, 3] += height
+        lift = cartesian_line(q_from, T_lift, s.cartesian_step)
+        if lift is not None and surroundings.clearance_ok(lift, hand=False).all():
+            return lift
+    return None
+
+
 def plan_pick(
     q_now: np.ndarray,
     q_grasp: np.ndarray,
@@ -284,10 +299,8 @@ def plan_pick(
     T_up = T_grasp.copy()
     T_up[2, 3] += s.regrip_lift
     up = cartesian_line(q_grasp, T_up, s.cartesian_step)
-    T_lift = T_grasp.copy()
-    T_lift[2, 3] += s.lift
-    lift = cartesian_line(up[-1], T_lift, s.cartesian_step) if up is not None else None
-    if up is None or lift is None or not surroundings.clearance_ok(lift, hand=False).all():
+    lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s)
+    if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = None
     clear = [q for q in via if world.clearance_ok(q)[0]]
