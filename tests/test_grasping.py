@@ -9,9 +9,10 @@ import pytest
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasp_detect import detect_grasps
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasping import GraspSet, find_grasps, vertical_grasp
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.types import FusedCloud, LaserMark, Segmentation, SupportSurface
+from laserpick.pipeline.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
+from laserpick.settings import get_settings
 
 TABLE = 0.46
 SPACING = 0.003
@@ -95,6 +96,25 @@ def test_a_too_wide_object_has_no_vertical_grasp():
     found = find_grasps(_perception((1.55, -0.3), r=0.06), dims.UR5_READY_Q, strategy="vertical")
     assert not isinstance(found, GraspSet)
     assert found.kind == "detect_grasp"
+
+
+def test_a_vertical_grasp_on_a_cup_seen_from_the_front_clears_its_far_rim():
+    """A 7 cm cup seen from the front and above: its top whole, only the front of its side.
+    The mean of its points lies toward the cameras; the hand is centred on the top all the
+    same, and each open finger keeps side_clearance from the cup on both sides."""
+    centre = np.array([1.50, -0.30])
+    r = 0.035
+    pts, _ = _cylinder(centre, r=r, height=0.07)
+    seen = pts[(pts[:, 0] < centre[0]) | (pts[:, 2] > pts[:, 2].max() - 1e-9)]
+    assert seen[:, 0].mean() < centre[0] - 0.008  # the points' mean lies toward the front
+    s = get_settings()
+    g = vertical_grasp(seen, TABLE, s)
+    assert isinstance(g, Grasp), g
+    assert np.linalg.norm(g.position[:2] - centre) < 0.002
+    # The cup's far and near sides along the closing axis, from the TCP.
+    c = g.closing[:2] / np.linalg.norm(g.closing[:2])
+    reach = np.abs((pts[:, :2] - g.position[:2]) @ c).max()
+    assert reach + s.grasp.side_clearance <= s.grasp.width_max / 2
 
 
 def test_an_object_seen_from_one_side_is_completed_by_symmetry():

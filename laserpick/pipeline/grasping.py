@@ -37,7 +37,8 @@ from laserpick.settings import MotionSettings, Settings, get_settings
 Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top
 VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
-VERTICAL_TOP_POINTS = 30  #: top points needed to centre a vertical grasp on the top face
+VERTICAL_CAP = 0.005  #: m below the top that a vertical grasp counts as the object's top face
+VERTICAL_TOP_POINTS = 30  #: points needed to place a vertical grasp by its band or top face
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready pose within this
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
@@ -73,32 +74,41 @@ class GraspSet:
 def vertical_grasp(
     target: np.ndarray, support: float | None, settings: Settings
 ) -> Grasp | Failure:
-    """A top-down grasp at the centroid, closing across the narrow side, the pads reaching
-    2 cm below the top but stopping 3 mm above the support surface at `support` (m). The
-    object must leave the open fingers side_clearance on each side.
+    """A top-down grasp on the target's top band, closing across its narrow side, the pads
+    reaching 2 cm below the top but stopping 3 mm above the support surface at `support`
+    (m). The hand is centred on the band's extent across, which must leave the open fingers
+    side_clearance on each side, and along it on the middle of the object's top face.
 
-    The centroid is the top face's, when the cameras see enough of it: they look down on
-    the object from the front, so the mean of all its points lies toward them.
+    The band is the target's points within VERTICAL_BITE of its top, where the fingers go,
+    when the cameras see enough of it; the top face, those within VERTICAL_CAP. The cameras
+    look down on the object from the front and see its top whole; they see less of its sides
+    and back, and the mean of all its points lies toward them (a mug's, 1.5 cm: its far rim
+    then met the far finger).
     """
-    top = target[target[:, 2] > target[:, 2].max() - VERTICAL_BITE]
-    centre = (top if len(top) >= VERTICAL_TOP_POINTS else target).mean(axis=0)
-    xy = target[:, :2] - centre[:2]
+    top = float(target[:, 2].max())
+    band = target[target[:, 2] > top - VERTICAL_BITE]
+    band = band if len(band) >= VERTICAL_TOP_POINTS else target
+    cap = target[target[:, 2] > top - VERTICAL_CAP]
+    centre = (cap if len(cap) >= VERTICAL_TOP_POINTS else band).mean(axis=0)
+    xy = band[:, :2] - centre[:2]
     _, vecs = np.linalg.eigh(np.cov(xy.T) if len(xy) > 2 else np.eye(2))
     closing = np.append(vecs[:, 0], 0.0)
     across = xy @ vecs[:, 0]
     # Robust extent: a few stray points (a shadow's edge, the table's rim) do not widen it.
-    width = float(np.percentile(across, 99.5) - np.percentile(across, 0.5))
+    lo, hi = np.percentile(across, [0.5, 99.5])
+    width = float(hi - lo)
     if width > settings.grasp.width_max - 2 * settings.grasp.side_clearance:
         return Failure("detect_grasp", "The object is wider than the gripper opens.")
+    middle = centre + 0.5 * (lo + hi) * closing
     approach = np.array([0.0, 0.0, -1.0])
     pose = np.eye(4)
     pose[:3, 0] = np.cross(closing, approach)
     pose[:3, 1] = closing
     pose[:3, 2] = approach
-    tips = float(target[:, 2].max()) - VERTICAL_BITE
+    tips = top - VERTICAL_BITE
     if support is not None:
         tips = max(tips, support + VERTICAL_FLOOR_GAP)
-    pose[:3, 3] = [centre[0], centre[1], tips + settings.grasp.pad_depth / 2]
+    pose[:3, 3] = [middle[0], middle[1], tips + settings.grasp.pad_depth / 2]
     return Grasp(pose=pose, width=width)
 
 
