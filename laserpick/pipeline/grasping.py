@@ -6,8 +6,8 @@ three strategies:
   symmetry; when still none is, again with the hand tilted about its closing axis; when
   still none is, the "vertical" grasp instead.
 - "overhead": EL-E's single overhead grasp from the target's 2D occupancy (000 section 4.4).
-- "vertical": a top-down grasp at the target's centroid across its narrow side, as Jeeves
-  takes once its base has centred the object (003 section IV).
+- "vertical": a top-down grasp across the narrow side of the target's top, as Jeeves takes
+  once its base has centred the object (003 section IV).
 
 Every candidate then goes through the reachability filter, is scored with 004's objective and
 clustered by position. Each stage is timed. Frames: `base`, metres, radians.
