@@ -648,9 +648,11 @@ class Behaviours:
             if cmd.done:
                 self.robot.drive(0.0, 0.0, 0.1)
                 self.robot.sleep(1.0)  # the ramp down; then look once more, at rest
-                return perceive(self.robot.capture(), point=top)
-            self.robot.drive(cmd.v, cmd.w, 0.5)
-            self.robot.sleep(APPROACH_PERIOD)
+            else:
+                self.robot.drive(cmd.v, cmd.w, 0.5)
+                self.robot.sleep(APPROACH_PERIOD)
+            # The scooter moved since the last look (in the ramp down too: turning at 0.46
+            # rad/s, by 13 degrees): where the target's top is now comes from the odometry.
             new_pose = self.robot.base_pose()
             moved = invert(planar_pose(*new_pose)) @ planar_pose(*pose)
             pose = new_pose
@@ -658,5 +660,7 @@ class Behaviours:
             if perception.segmentation is None:
                 self.robot.drive(0.0, 0.0, 0.1)
                 return Failure("detect_laser", "I lost sight of the object.")
+            if cmd.done:
+                return perception
         self.robot.drive(0.0, 0.0, 0.1)
         return Failure("execute", "The scooter did not reach the object.")

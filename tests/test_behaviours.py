@@ -11,6 +11,8 @@ import pytest
 
 from laserpick.behaviours import PLACE_YAWS, Behaviours, drop_candidates, turned_hand_xy
 from laserpick.bench.operator import Referee
+from laserpick.bench.protocols import jeeves_scene
+from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
@@ -20,7 +22,7 @@ from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
 from laserpick.pipeline.selection import group, score
 from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import Grasp
+from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import matrix_from_quat
@@ -96,6 +98,28 @@ def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
     assert np.abs(s.arm_qd).max() < 0.05
     assert tcp_pose(s.arm_q)[2, 3] > TABLE_TOP + 0.03, "it backed off upward"
     assert not s.gripper_closed
+
+
+def test_the_centroid_approach_keeps_sight_of_the_object_through_its_last_turn():
+    """Jeeves' approach to a can on the near left of its table ends turning right; the
+    scooter still turns while it stops, and the last look must follow it by the odometry.
+    It did not: the stopped scooter looked where the can had been and saw nothing."""
+    robot = SimRobot(jeeves_scene("soda_can", "loc1"), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        frames, labels = robot.capture_with_labels()
+        top = Captured(robot, frames, labels).visible_top(fuse(frames), "soda_can")
+        assert top is not None
+        beh = Behaviours(robot)
+        out = beh.approach(perceive(frames, point=top))
+        assert not isinstance(out, Failure), out
+        seen = out.target_points.mean(axis=0)
+        truth = Referee(robot).position("soda_can")
+        assert np.linalg.norm(seen[:2] - truth[:2]) < 0.03  # it is the can, where it stands
+        spot = np.array(beh.settings.approach.grasp_spot)
+        assert abs(truth[0] - spot[0]) < 0.1 and abs(truth[1] - spot[1]) < 0.25
+    finally:
+        robot.close()
 
 
 def test_preconditions_are_checked(robot):
