@@ -176,13 +176,16 @@ class ScriptedOperator:
         rests idle; `rec` says why). aim: where to aim (m, `base`; default: the middle of the
         object's visible top, where a person would aim)."""
         s = self.session
+        # Aiming at the object, the user looks for the dot on it; aiming at a given point
+        # (002's laser scan, which tries points up to the object's edges), they do not.
+        on = rec.instance if aim is None else None
         aim = aim if aim is not None else self.referee.aim_point(rec.instance)
         if aim is None:
             rec.fail("detect_laser", "no camera sees the object")
             return False
         for _ in range(REMARKS + 1):
             rec.marks += 1
-            self.aim(aim, on=rec.instance)
+            self.aim(aim, on=on)
             k = len(self._events)
             s.confirm(BENCH)
             self.wait()
