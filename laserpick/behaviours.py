@@ -257,6 +257,11 @@ class Behaviours:
         if np.max(np.abs(self._q() - dims.UR5_HOME_Q)) < 0.05:
             return Outcome()
         out = self.go_ready(checker)
+        if out.failure is not None and out.failure.kind == "ik_plan" and checker is not None:
+            # No way to either ready pose (the hand set an object down on the 108 cm table,
+            # which fills both): fold away from where it is, by a checked search.
+            direct = self.go_to(dims.UR5_HOME_Q, checker, "stowing")
+            return direct if direct.ok else out
         if not out.ok:
             return out
         return self.go_to(dims.UR5_HOME_Q, checker or CollisionChecker(np.zeros((0, 3))), "stowing")

@@ -84,11 +84,37 @@ def test_before_a_counter_above_the_ready_hand_the_arm_goes_to_the_high_ready_po
     assert np.abs(robot.joint_state().q - dims.UR5_HIGH_READY_Q).max() < 0.05
 
 
-def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
-    # The planner sees nothing (an empty cloud); the grasp is 4 cm into the table top.
+def test_with_both_ready_poses_filled_the_arm_stows_by_a_search(robot):
+    """A table top at 1.06 m fills both ready poses' hands (the place on the 108 cm high
+    table has just let go, its hand above it): the stow folds the arm away from where it
+    is instead of finding no way."""
+    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
+    top = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    checker = CollisionChecker(top)
+    assert not checker.clearance_ok(dims.UR5_READY_Q)[0]
+    assert not checker.clearance_ok(dims.UR5_HIGH_READY_Q)[0]
+    # The hand 6 cm above the top, the elbow up and the shoulder turned forward, as it
+    # rests after letting go there.
+    solutions = ik_tcp(_top_down(1.55, -0.30, 1.12), dims.UR5_HIGH_READY_Q)
+    above = next(q for q in solutions if abs(q[0]) < 1.0 and checker.clearance_ok(q)[0])
+    b = Behaviours(robot)
+    assert b.go_to(above, CollisionChecker(np.zeros((0, 3))), "setting up").ok
+    out = b.stow(checker)
+    assert out.ok, out.failure
+    assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
+
+
+def _top_down(x: float, y: float, z: float) -> np.ndarray:
+    """A TCP pose at (x, y, z) in `base`, the gripper pointing down."""
     pose = np.eye(4)
     pose[:3, :3] = np.diag([1.0, -1.0, -1.0])
-    pose[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.04 + 0.011]
+    pose[:3, 3] = [x, y, z]
+    return pose
+
+
+def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
+    # The planner sees nothing (an empty cloud); the grasp is 4 cm into the table top.
+    pose = _top_down(1.5, -0.3, TABLE_TOP - 0.04 + 0.011)
     b = Behaviours(robot)
     out = b.pick(_grasp_set(pose, CollisionChecker(np.zeros((0, 3)))))
     assert not out.ok and out.failure.kind == "execute"
