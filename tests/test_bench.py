@@ -35,6 +35,7 @@ from laserpick.bench.protocols import (
     PROTOCOLS,
     UPRIGHT_TILT,
     Options,
+    _operated,
     coin_flip_kitchen,
     jeeves_scene,
     placed_tilt,
@@ -261,6 +262,28 @@ def test_the_user_sees_whether_the_dot_is_on_the_object() -> None:
         assert hit, "the dot aimed beside the mug lies on the table"
     finally:
         cap.close()
+
+
+def test_the_helper_empties_the_basket_of_any_object_after_an_attempt() -> None:
+    """An object that fell in the basket (a wrong object's pick) stands in the laser's way;
+    tidying after the attempt takes it out, whatever it was."""
+    scene = load_scene("isolation", seed=1)
+    with _operated(scene, 0, 1, Options()) as op:
+        name = scene.placements[0].instance
+        T_world_base = planar_pose(*op.robot.base_pose())
+        drop = (T_world_base @ np.append(dims.BASKET_CENTER + [0.0, 0.0, 0.05], 1.0))[:3]
+
+        def into_basket(m, d) -> None:
+            j = m.joint(f"obj/{name}")
+            d.qpos[j.qposadr[0] : j.qposadr[0] + 3] = drop
+            d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
+
+        op.robot.sim.call(into_basket)
+        op.robot.sleep(1.0)
+        assert op.referee.in_basket(name)
+        op.tidy()
+        assert not op.referee.in_basket(name)
+        assert np.linalg.norm(op.referee.position(name)[:2]) > 3.0  # out of the scene
 
 
 def test_retries_at_one_object_count_as_one_task() -> None:

@@ -289,8 +289,13 @@ class ScriptedOperator:
 
     def tidy(self) -> None:
         """Reset what a failed attempt left: an object still in the hand is taken out of it
-        (and out of the scene), a stuck arm is moved home by hand, and the session is told."""
+        (and out of the scene), so is one dropped in the basket (a wrong object's: it stood
+        in the beam's way, and no later dot was seen), a stuck arm is moved home by hand, and
+        the session is told."""
         s, robot = self.session, self.robot
+        for name in self.referee.instances():
+            if self.referee.in_basket(name):
+                self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
             held = s.behaviours.held
             robot.gripper(False)
