@@ -33,8 +33,8 @@ BENCH = Actor("bench")
 #: under them), as 004's users re-aimed.
 REMARKS = 2
 #: Times the operator aims before confirming, until the dot they see lies on the object. A
-#: dot that grazed past a low object's top onto the wall behind is seen and re-aimed; 004's
-#: users confirmed once the dot was on the object.
+#: dot that grazed past a low object's top onto the wall behind is seen and re-aimed: a
+#: person confirms once they see the dot on the object.
 AIMS = 5
 #: Longest a session job may take (s of wall time) before the run is declared hung.
 JOB_TIMEOUT = 600.0
