@@ -254,15 +254,13 @@ class ScriptedOperator:
 
     def pick_and_drop(self, rec: Attempt, aim: np.ndarray | None = None) -> Attempt:
         """One 004 section 8.1 attempt: success is the simulator's word that the marked
-        object lies in the basket (it is then taken out, as a helper empties the basket).
+        object lies in the basket (`tidy` then takes it out, as a helper empties the basket).
         aim: as for `mark`."""
         self.session.set_mode(BENCH, mode="pick_and_drop")
         if self.pick(rec, aim) and rec.failure is None:
             self.robot.sleep(0.5)
             rec.success = self.referee.in_basket(rec.instance)
-            if rec.success:
-                self.referee.take_out(rec.instance)
-            else:
+            if not rec.success:
                 rec.fail("execute", "the object did not land in the basket")
         # 004 section 8.1 counts a grasp as successful once the object is in the basket: one
         # lifted but dropped on the way, or kept because no way to the basket was found, is not.
@@ -288,10 +286,10 @@ class ScriptedOperator:
     # --- the experimenter -------------------------------------------------------------------
 
     def tidy(self) -> None:
-        """Reset what a failed attempt left: an object still in the hand is taken out of it
-        (and out of the scene), so is one dropped in the basket (a wrong object's: it stood
-        in the beam's way, and no later dot was seen), a stuck arm is moved home by hand, and
-        the session is told."""
+        """Reset what an attempt left: every object in the basket is taken out of the scene
+        (the fetched one, or another a wrong grasp dropped there: it would stand in the beam's
+        way), so is an object still in the hand, a stuck arm is moved home by hand, and the
+        session is told."""
         s, robot = self.session, self.robot
         for name in self.referee.instances():
             if self.referee.in_basket(name):

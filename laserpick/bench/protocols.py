@@ -63,7 +63,7 @@ from laserpick.robot.scenes import (
     scene_config,
 )
 from laserpick.server.session import Selection, StrategyName, TaskState
-from laserpick.transforms import invert, matrix_from_quat, planar_pose
+from laserpick.transforms import matrix_from_quat, planar_pose
 
 #: Tries per object in the in-situ protocol (004 section 8.2 retried until retrieved).
 MAX_TRIES = 3
@@ -484,7 +484,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     outline = op.referee.outline()  # the object in hand included
     if not _park(op, scene, dest, local_x, local_y, spot_world[2], outline):
         return rec.fail("precondition", f"the user could not park at {dest.name}")
-    spot_base = (invert(planar_pose(*op.base_pose())) @ np.append(spot_world, 1.0))[:3]
+    spot_base = referee.to_base(spot_world)
     placed = op.place(spot_base)
     if placed.failure is not None or placed.hit is None:
         failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
