@@ -1,8 +1,10 @@
 """Click-to-highlight latency of the 3D console (issue 6's target: 250 ms or less).
 
-A real `laserpick serve` on `isolation`, its 3D view in headless Chromium. For each object:
-click on it (aim), click again on the same spot (confirm), and time from the confirming
-click's pointerdown in the browser to the 3D view sending the lit cloud to the browser (its
+A real `laserpick serve` on `isolation`, and its page at `/` in headless Chromium, the 3D view
+in the page's frame at the detail the page chooses (`--detail`; "auto" is half on this
+machine, which draws WebGL without a GPU). For each object: click on it in the 3D view
+(aim), click again on the same spot (confirm), and time from the confirming click's
+pointerdown in the browser to the 3D view sending the lit cloud to the browser (its
 `highlight` event on the events stream). Both clocks are this machine's wall clock. Not
 counted: the loopback hop back to the browser and the frame that draws it; the script
 prints the browser's frame interval beside the figure for that. Between trials the mark is
@@ -10,7 +12,8 @@ cancelled. `--pause S` waits S seconds between the aiming click taking effect an
 confirming click, as a person does who looks at the dot before confirming it; at 0 (the
 default) the confirming click lands while the browser is still drawing the aim.
 
-    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--pause S] [--no-browser]
+    MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--pause S]
+        [--detail auto|full|half] [--no-browser]
 
 `--no-browser` measures the server alone, in this process: the session, the 3D view's drawing
 and its viser server without a browser, from a click-confirmed mark (`Session.confirm` with
@@ -57,6 +60,15 @@ requestAnimationFrame(tick);
 """
 
 
+def detail_setting(detail: str) -> str:
+    """A script that gives the page's remembered settings this 3D view detail."""
+    return f"""
+try {{
+  localStorage.setItem("laserpick.settings.operator", JSON.stringify({{ viewDetail: "{detail}" }}));
+}} catch {{}}
+"""
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
@@ -67,6 +79,12 @@ def main() -> int:
         default=0.0,
         help="seconds between the aiming click taking effect and the confirming click (a"
         " person looks at the dot first); 0: at once",
+    )
+    parser.add_argument(
+        "--detail",
+        choices=("auto", "full", "half"),
+        default="auto",
+        help="the page's 3D view detail setting (auto: half without a GPU)",
     )
     args = parser.parse_args()
     if args.no_browser:
@@ -82,12 +100,15 @@ def main() -> int:
             objects = [o for o in api.get("/sim/objects") if not o["in_basket"]]
             with sync_playwright() as p:
                 browser = headless_chromium.launch(p)
-                page = browser.new_page(viewport={"width": 900, "height": 600})
-                page.add_init_script(PROBE)
-                page.goto(server.viser_url)
-                page.get_by_role("button", name="Detect").wait_for(timeout=30_000)
+                page = browser.new_page(viewport={"width": 1280, "height": 800})
+                page.add_init_script(PROBE + detail_setting(args.detail))  # in every frame
+                page.goto(server.url)
+                view = page.frame_locator("iframe#view")
+                view.get_by_role("button", name="Detect").wait_for(timeout=30_000)
+                frame = next(f for f in page.frames if f.url.startswith(server.viser_url))
+                print(f"3D view: {frame.url}")
                 time.sleep(5.0)  # the scene fades in
-                box = page.locator("canvas").first.bounding_box()
+                box = view.locator("canvas").first.bounding_box()
                 for _ in range(args.rounds):
                     for obj in objects:
                         x, y = default_view_pixel(obj["center_base"], box["width"], box["height"])
@@ -102,7 +123,7 @@ def main() -> int:
                         api.wait_for(lambda s: s["state"] != "aiming" or s["busy"], 20)
                         state = api.wait_for(lambda s: not s["busy"], 60)
                         time.sleep(0.5)
-                        clicked = page.evaluate("window.__lp.downs")[-1] / 1000.0
+                        clicked = frame.evaluate("window.__lp.downs")[-1] / 1000.0
                         shown = [
                             e
                             for e in api.events[seen:]
@@ -119,7 +140,7 @@ def main() -> int:
                         else:
                             print(f"{obj['name']:>18}: no highlight ({state['message']})")
                         api.post("/cancel")
-                frames = page.evaluate("window.__lp.frames")
+                frames = frame.evaluate("window.__lp.frames")
                 browser.close()
         finally:
             api.release()

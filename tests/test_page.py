@@ -242,7 +242,9 @@ def wait_rendered(page) -> None:
 def _renders(page, server: ServeProcess) -> None:
     frame = page.locator("iframe#view")
     assert frame.get_attribute("title"), "the 3D view's iframe needs a title"
-    assert frame.get_attribute("src") == server.viser_url + "/"
+    # This browser draws WebGL without a GPU: "auto" detail is half (a quarter of the pixels).
+    assert frame.get_attribute("src") == server.viser_url + "/?fixedDpr=0.5"
+    assert "without a GPU" in page.locator("#view-detail-note").text_content()
     wait_rendered(page)
     ARTIFACTS.mkdir(exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / "page.png"))
@@ -268,6 +270,14 @@ def _renders(page, server: ServeProcess) -> None:
     tab_to(page, "Cancel")
     page.keyboard.press("Space")
     wait_state(server, lambda s: s["state"] == "idle", 10)
+
+    # Full detail on request, remembered: the view reloads without the half-detail setting.
+    page.locator("#settings > summary").click()
+    page.get_by_label("3D view detail").select_option("full")
+    assert frame.get_attribute("src") == server.viser_url + "/"
+    assert '"viewDetail":"full"' in page.evaluate(
+        "localStorage.getItem('laserpick.settings.operator')"
+    )
 
 
 # --- 2. accessible names and target sizes -----------------------------------------------

@@ -27,7 +27,7 @@ const PAD_DEADMAN = 5;    // RB, standard mapping: hold for any drive motion
 // --- settings, remembered per user in this browser (localStorage) -------------------------
 
 const DEFAULTS = {
-  step: "0.05", level: "cluster", speed: "0.3", speech: false, showView: true,
+  step: "0.05", level: "cluster", speed: "0.3", speech: false, showView: true, viewDetail: "auto",
   scanMode: "off", period: 1.0, cycles: 3, accept: 0.1, release: 0.1,  // as the switch adapter
   key1: "Space", key2: "Enter",
 };
@@ -71,7 +71,7 @@ function readSetting(el) {
     el.value = String(settings[k]);
   } else settings[k] = el.value;
   saveSettings();
-  if (k === "showView") showView(settings.showView);
+  if (k === "showView" || k === "viewDetail") showView(settings.showView);
   if (k === "scanMode") setScanMode(settings.scanMode);
   if (k === "speech" && settings.speech) speak("Speech on.", true);
 }
@@ -839,13 +839,37 @@ addEventListener("gamepadconnected", startPad);
 // --- the 3D view ----------------------------------------------------------------------------
 
 let viewUrl = null;
+
+// The name of what draws WebGL here, if it is software (no GPU), else null.
+const softwareGL = (() => {
+  try {
+    const gl = document.createElement("canvas").getContext("webgl");
+    const ext = gl && gl.getExtension("WEBGL_debug_renderer_info");
+    const name = ext ? String(gl.getParameter(ext.UNMASKED_RENDERER_WEBGL)) : "";
+    return (/SwiftShader|llvmpipe|softpipe|Software/i.exec(name) || [null])[0];
+  } catch { return null; }
+})();
+
+// The 3D view's address with its detail: "half" draws a quarter of the pixels. Without a GPU
+// a full-detail frame takes 70 ms or more, and a click waits behind the frames being drawn
+// (bench/click_latency.py), so "auto" is half there and full elsewhere.
+function viewSrc() {
+  const half = settings.viewDetail === "half" || (settings.viewDetail === "auto" && softwareGL);
+  const url = new URL(viewUrl);
+  if (half) url.searchParams.set("fixedDpr", "0.5");
+  return url.href;
+}
+
 function showView(on) {
   const frame = $("view");
   frame.hidden = !on;
   $("view-off").hidden = on;
+  $("view-detail-note").textContent = softwareGL
+    ? `This browser draws without a GPU (${softwareGL}): "auto" is half detail.`
+    : "This browser draws with a GPU: \"auto\" is full detail.";
   // Hidden means not loaded: software WebGL would spend the robot computer's CPU for nothing.
   if (!on) frame.removeAttribute("src");
-  else if (viewUrl && frame.getAttribute("src") !== viewUrl) frame.src = viewUrl;
+  else if (viewUrl && frame.getAttribute("src") !== viewSrc()) frame.src = viewSrc();
 }
 async function findView() {
   try {
