@@ -851,8 +851,9 @@ const softwareGL = (() => {
 })();
 
 // The 3D view's address with its detail: "half" draws a quarter of the pixels. Without a GPU
-// a full-detail frame takes 70 ms or more, and a click waits behind the frames being drawn
-// (bench/click_latency.py), so "auto" is half there and full elsewhere.
+// a full-detail frame takes 70-85 ms, and while the scene changes the browser spends most of
+// the robot computer's CPU drawing (bench/view_load.py), so "auto" is half there and full
+// elsewhere.
 function viewSrc() {
   const half = settings.viewDetail === "half" || (settings.viewDetail === "auto" && softwareGL);
   const url = new URL(viewUrl);
