@@ -90,27 +90,6 @@ def test_drive_is_a_dead_man_with_acceleration_limits(sim):
     assert 0.05 < moved < 0.6 * 0.5 + 0.05
 
 
-def test_the_parked_scooter_holds_still_when_pushed_and_drives_when_told(sim):
-    """Parked, the brake holds the base. A push of 150 N and 60 N m for a second (the arm's
-    hand swinging into a counter beside the scooter turned it 2.7 deg before, and the grasp
-    then missed by 8 cm) moves it by under a millimetre and a milliradian. Driven, it
-    moves."""
-    from laserpick.robot.model import SCOOTER_BODY
-
-    body = sim.model.body(SCOOTER_BODY).id
-    p0 = sim.snapshot().base_pose.copy()
-    sim.data.xfrc_applied[body] = [150.0, -150.0, 0.0, 0.0, 0.0, 60.0]
-    sim.settle(1.0)
-    sim.data.xfrc_applied[body] = 0.0
-    sim.settle(0.5)
-    moved = sim.snapshot().base_pose - p0
-    assert np.linalg.norm(moved[:2]) < 1e-3, moved
-    assert abs(moved[2]) < 1e-3, moved
-    sim.drive(0.4, 0.0)
-    sim.settle(1.5)
-    assert sim.snapshot().base_pose[0] - p0[0] > 0.05
-
-
 def test_drive_turns_with_the_heading(sim):
     for _ in range(20):
         sim.drive(0.0, 0.8)

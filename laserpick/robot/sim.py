@@ -38,11 +38,6 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 
 #: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
 _CHUNK_STEPS = 10
-#: Parking brake stiffness (1/s): parked, each base joint's velocity servo is sent this times
-#: its offset from where the scooter stopped (m or rad), holding it there as a mobility
-#: scooter's electromagnetic brake does. The servos alone yield to the arm's reaction: the
-#: scooter turned 2.7 deg while the arm reached for the floor, and the grasp missed by 8 cm.
-BRAKE_GAIN = 20.0
 
 
 class MotionHandle:
@@ -153,7 +148,6 @@ class Simulation:
             self._drive_cmd = np.zeros(2)
             self._drive_deadline = -1.0
             self._drive_now = np.zeros(2)
-            self._parked_at: np.ndarray | None = None
             self.estopped = False
             self._steps = 0
             mujoco.mj_forward(m, d)
@@ -424,12 +418,6 @@ class Simulation:
         want = self._drive_cmd if d.time < self._drive_deadline else np.zeros(2)
         limits = np.array([dims.BASE_A_MAX, dims.BASE_ALPHA_MAX]) * dt
         self._drive_now = self._drive_now + np.clip(want - self._drive_now, -limits, limits)
-        if not (want.any() or self._drive_now.any()):
-            if self._parked_at is None:
-                self._parked_at = d.qpos[info.base_qpos].copy()
-            d.ctrl[info.base_ctrl] = BRAKE_GAIN * (self._parked_at - d.qpos[info.base_qpos])
-            return
-        self._parked_at = None
         v, w = self._drive_now
         yaw = d.qpos[info.base_qpos[2]]
         d.ctrl[info.base_ctrl] = [v * math.cos(yaw), v * math.sin(yaw), w]
@@ -459,7 +447,6 @@ class Simulation:
         self._drive_cmd[:] = 0.0
         self._drive_now[:] = 0.0
         self._drive_deadline = -1.0
-        self._parked_at = None  # braked where it stopped
         d.ctrl[info.base_ctrl] = 0.0
 
     def _refuse_when_stopped(self, handle: MotionHandle) -> bool:
