@@ -31,6 +31,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from playwright.sync_api import sync_playwright
@@ -69,6 +70,19 @@ try {{
 """
 
 
+def open_view(browser: Any, server: ServeProcess, detail: str, probe: str) -> tuple[Any, Any]:
+    """The page at `/` in a new 1280 x 800 tab of `browser`, its 3D view at `detail`, once the
+    view has loaded and its scene faded in; `probe` runs in every frame before the page's
+    own scripts. Returns the page and the 3D view's frame."""
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    page.add_init_script(probe + detail_setting(detail))
+    page.goto(server.url)
+    page.frame_locator("iframe#view").get_by_role("button", name="Detect").wait_for(timeout=30_000)
+    frame = next(f for f in page.frames if f.url.startswith(server.viser_url))
+    time.sleep(6.0)  # the scene fades in
+    return page, frame
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
@@ -100,15 +114,9 @@ def main() -> int:
             objects = [o for o in api.get("/sim/objects") if not o["in_basket"]]
             with sync_playwright() as p:
                 browser = headless_chromium.launch(p)
-                page = browser.new_page(viewport={"width": 1280, "height": 800})
-                page.add_init_script(PROBE + detail_setting(args.detail))  # in every frame
-                page.goto(server.url)
-                view = page.frame_locator("iframe#view")
-                view.get_by_role("button", name="Detect").wait_for(timeout=30_000)
-                frame = next(f for f in page.frames if f.url.startswith(server.viser_url))
+                page, frame = open_view(browser, server, args.detail, PROBE)
                 print(f"3D view: {frame.url}")
-                time.sleep(5.0)  # the scene fades in
-                box = view.locator("canvas").first.bounding_box()
+                box = page.frame_locator("iframe#view").locator("canvas").first.bounding_box()
                 for _ in range(args.rounds):
                     for obj in objects:
                         x, y = default_view_pixel(obj["center_base"], box["width"], box["height"])

@@ -26,7 +26,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
 sys.path.insert(0, str(REPO / "bench"))
 
-from click_latency import detail_setting  # noqa: E402
+from click_latency import open_view  # noqa: E402
 from serve_process import ServeProcess  # noqa: E402
 
 from laserpick.client import Client  # noqa: E402
@@ -67,12 +67,7 @@ def main() -> int:
 
 
 def measure(browser, server: ServeProcess, api: Client, detail: str) -> None:
-    page = browser.new_page(viewport={"width": 1280, "height": 800})
-    page.add_init_script(PROBE + detail_setting(detail))
-    page.goto(server.url)
-    page.frame_locator("iframe#view").get_by_role("button", name="Detect").wait_for(timeout=30_000)
-    frame = next(f for f in page.frames if f.url.startswith(server.viser_url))
-    time.sleep(6.0)  # the scene fades in
+    page, frame = open_view(browser, server, detail, PROBE)
     frame.evaluate("window.__long = []")
     t0 = time.monotonic()
     for k in range(NUDGES):

@@ -870,7 +870,10 @@ function showView(on) {
     : "This browser draws with a GPU: \"auto\" is full detail.";
   // Hidden means not loaded: software WebGL would spend the robot computer's CPU for nothing.
   if (!on) frame.removeAttribute("src");
-  else if (viewUrl && frame.getAttribute("src") !== viewSrc()) frame.src = viewSrc();
+  else if (viewUrl) {
+    const src = viewSrc();
+    if (frame.getAttribute("src") !== src) frame.src = src;
+  }
 }
 async function findView() {
   try {
