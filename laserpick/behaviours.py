@@ -33,7 +33,7 @@ from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.surface import place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
-from laserpick.robot.interface import Robot
+from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.transforms import invert, planar_pose, roty, rotz
 
@@ -196,6 +196,9 @@ class Behaviours:
         if status == "running":
             self.robot.halt()  # not the latching e-stop: that one stays the user's
             return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
+        if handle.message.startswith(PROTECTIVE_STOP):
+            felt = handle.message.removeprefix(PROTECTIVE_STOP)
+            return Failure("execute", f"The arm was pushed back while {what} ({felt}): stopped.")
         return Failure("execute", f"The arm stopped while {what}: {handle.message}.")
 
     def _q(self) -> np.ndarray:

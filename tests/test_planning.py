@@ -66,17 +66,59 @@ def test_body_frames_match_the_simulated_links():
             b = m.body(f"ur5/link{i + 1}").id
             assert np.allclose(d.xpos[b], F[i, :3, 3], atol=1e-9)
             assert np.allclose(d.xmat[b].reshape(3, 3), F[i, :3, :3], atol=1e-9)
-        # The sphere model covers each MuJoCo capsule's end points.
+        # The sphere model covers each MuJoCo capsule's end points, joint housings included.
         centres = sphere_centres(body_frames(q))[0]
         for g in range(m.ngeom):
             name = m.geom(g).name
-            if not (name.startswith("ur5/link") and "/c" in name):
+            if not name.startswith("ur5/link"):
                 continue
-            half = m.geom_size[g, 1]
+            radius, half = m.geom_size[g, :2]
+            if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE:  # a joint housing
+                half = 0.0
+            else:
+                assert m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE, name
             axis = d.geom_xmat[g].reshape(3, 3)[:, 2]
             for end in (d.geom_xpos[g] + half * axis, d.geom_xpos[g] - half * axis):
                 gap = np.linalg.norm(centres - end, axis=1) - SPHERES.radius
-                assert gap.min() < -m.geom_size[g, 0] + 1e-6
+                assert gap.min() < -radius + 1e-6, name
+
+
+def test_keepout_boxes_hold_every_part_of_the_scooter_the_arm_can_reach():
+    # The arm struck the projector and a camera housing, which stood outside the planner's
+    # boxes. Points over every part from the posts up (and over the tiller and the basket)
+    # lie in some box: a box's corners and a grid between them (a cylinder's box), a
+    # capsule's surface.
+    m = build_sim_model(None)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    lo, hi = np.array([b.lo for b in KEEPOUT_BOXES]), np.array([b.hi for b in KEEPOUT_BOXES])
+    turn = np.array([b.turn for b in KEEPOUT_BOXES])
+    parts = ("sensor_", "post_", "projector", "tiller", "handlebar", "basket_", "arm_pedestal")
+    steps = np.linspace(-1, 1, 5)
+    cube = np.stack(np.meshgrid(steps, steps, steps), -1).reshape(-1, 3)
+    outward = cube[np.linalg.norm(cube, axis=1) > 0]
+    ball = outward / np.linalg.norm(outward, axis=1)[:, None]
+    checked = 0
+    for g in range(m.ngeom):
+        name = m.geom(g).name.removeprefix("scooter/")
+        if not name.startswith(parts):
+            continue
+        R, size = d.geom_xmat[g].reshape(3, 3), m.geom_size[g]
+        if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:
+            local = cube * size
+        elif m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            local = cube * [size[0], size[0], size[1]]  # the box around it
+        else:
+            assert m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE, name
+            axis = steps[:, None] * np.array([0.0, 0.0, size[1]])
+            local = (axis[:, None] + size[0] * ball[None]).reshape(-1, 3)
+        points = local @ R.T + d.geom_xpos[g]  # m, `base`
+        local = np.einsum("pj,kji->pki", points, turn)  # in each box's frame
+        inside = np.all((local >= lo - 1e-6) & (local <= hi + 1e-6), axis=2)
+        assert inside.any(axis=1).all(), f"{name}: {points[~inside.any(axis=1)][:3]}"
+        checked += 1
+    assert checked == 17  # five sensors, two posts, projector and bracket, tiller, bar,
+    # basket, pedestal
 
 
 def test_stowed_and_ready_poses_are_clear_and_the_checker_sees_what_it_should():

@@ -1,8 +1,10 @@
 """Collision geometry of the robot for planning: the UR5's link capsules, the gripper's, and
 keep-out boxes around the scooter and its rider.
 
-The same capsule table builds the MuJoCo model (robot/model.py) and the planner's sphere
-model (pipeline/collision.py), so what the planner avoids is what the simulator collides.
+The same tables build the MuJoCo model (robot/model.py) and the planner's sphere model and
+keep-out boxes (pipeline/collision.py), so what the planner avoids is what the simulator
+collides: the link capsules, the joint housings around each joint, and the boxes of the
+cameras and the projector on the scooter's posts.
 
 Frames: link capsules are given in the frame of MuJoCo body `link{i+1}`, which is DH frame i
 turned by q_{i+1} about its z axis; gripper capsules in the flange frame (z = approach);
@@ -18,6 +20,7 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.description.kinematics import T_BASE_UR5
+from laserpick.transforms import roty, rotz
 
 #: Physical offsets along the shoulder and elbow joint axes (m): the UR5's shoulder and elbow
 #: sit to the side of the DH line, and the DH d4 is their net sum.
@@ -42,6 +45,17 @@ def _link_capsules() -> tuple[tuple[Segment, ...], ...]:
 
 #: Capsules (from, to, radius) of each of the six links, in that link's body frame (m).
 LINK_CAPSULES: tuple[tuple[Segment, ...], ...] = _link_capsules()
+#: The joint housings: a ball, or a short capsule along the joint's axis, around each link's
+#: joint at its body frame's origin (from, to, radius; m). A little wider than the link
+#: tubes, they reach past the tubes' ends: planned without them, the wrist struck the
+#: projector (155 N in an isolation run).
+HOUSING_CAPSULES: tuple[Segment, ...] = tuple(
+    ((0.0, 0.0, -reach), (0.0, 0.0, reach), r)
+    for r, reach in (
+        (radius * 1.08, max(0.0, (0.06 if i < 3 else 0.045) - radius * 1.08))
+        for i, radius in enumerate(dims.UR5_LINK_RADII[1:])
+    )
+)
 
 _FINGER_Y = dims.GRIPPER_STROKE / 2 + dims.GRIPPER_PAD_THICKNESS  # pad/plate seam, open
 _FINGER_R = 0.010  # two capsules side by side cover the 24 x 16 mm plate-and-pad section
@@ -57,13 +71,79 @@ GRIPPER_CAPSULES: tuple[Segment, ...] = (
 )
 
 
+_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
 @dataclass(frozen=True)
 class Box:
-    """An axis-aligned keep-out box in `base`: lower and upper corners (m)."""
+    """A keep-out box: lower and upper corners (m) along its own axes, the columns of the
+    rotation `turn` (identity: axis-aligned in `base`); a point p of `base` lies in it where
+    lo <= turn.T @ p <= hi. `spares`: the arm's bodies (0 = link1 ... 6 =
+    the hand) not checked against it, as the first link standing on the arm's pedestal."""
 
     name: str
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
+    spares: tuple[int, ...] = ()
+    turn: tuple[tuple[float, float, float], ...] = _IDENTITY
+
+
+@dataclass(frozen=True)
+class Housing:
+    """A box-shaped part on the scooter's posts, in `base`: its centre (m), its half extents
+    in its own frame (m) and that frame's rotation."""
+
+    name: str
+    centre: tuple[float, float, float]
+    half: tuple[float, float, float]
+    R: np.ndarray
+
+    def keepout(self, pad: float) -> Box:
+        """The keep-out box of it, `pad` (m) larger on every side."""
+        middle = self.R.T @ np.asarray(self.centre)
+        half = np.asarray(self.half) + pad
+        turn = tuple(tuple(float(v) for v in row) for row in self.R)
+        return Box(self.name, tuple(middle - half), tuple(middle + half), turn=turn)
+
+
+#: A depth sensor's housing (half extents, m, in the sensor's frame: x along its view) and
+#: how far behind the lens its centre sits (m), so that no camera sees its own box.
+SENSOR_HOUSING_HALF = (0.015, 0.06, 0.015)
+SENSOR_HOUSING_BEHIND = 0.02
+#: The projector's housing (half extents, m) and its centre's height over the lens (m).
+PROJECTOR_HOUSING_HALF = (0.06, 0.09, 0.035)
+PROJECTOR_HOUSING_RAISE = 0.03
+#: The sensor posts' radius (m): poles at x = SENSOR_X - POST_BACK, y = +-spacing / 2.
+POST_RADIUS = 0.015
+POST_BACK = 0.1
+#: The arm's pedestal: a column (radius, m) from the bracket at this height (m) up to the
+#: arm's mount.
+PEDESTAL_RADIUS = 0.07
+PEDESTAL_FOOT = 0.15
+#: Clearance (m) the keep-out boxes add around the posts, the pedestal and the housings.
+HOUSING_PAD = 0.005
+
+
+def _housings() -> tuple[Housing, ...]:
+    out = []
+    for mount in dims.CAMERA_MOUNTS:
+        R = rotz(mount.yaw) @ roty(mount.pitch_down)
+        centre = np.asarray(mount.pos) - R[:, 0] * SENSOR_HOUSING_BEHIND
+        out.append(Housing(f"sensor_{mount.name}", tuple(centre), SENSOR_HOUSING_HALF, R))
+    px, py, pz = dims.PROJECTOR_POS
+    out.append(
+        Housing(
+            "projector",
+            (px, py, pz + PROJECTOR_HOUSING_RAISE),
+            PROJECTOR_HOUSING_HALF,
+            rotz(dims.PROJECTOR_YAW),
+        )
+    )
+    return tuple(out)
+
+
+#: The five depth sensors' housings and the projector's.
+HOUSINGS: tuple[Housing, ...] = _housings()
 
 
 def _keepout() -> tuple[Box, ...]:
@@ -73,12 +153,13 @@ def _keepout() -> tuple[Box, ...]:
     w = dims.BASKET_WALL + 0.005
     bx0, by0, bz0 = dims.BASKET_CENTER - dims.BASKET_INNER / 2 - w
     bx1, by1, bz1 = dims.BASKET_CENTER + dims.BASKET_INNER / 2 + w
-    post_x = dims.SENSOR_X - 0.1
+    post_x = dims.SENSOR_X - POST_BACK
     post_y = dims.SENSOR_GROUP_SPACING / 2
+    pole = POST_RADIUS + HOUSING_PAD
+    mx, my, mz = dims.ARM_MOUNT_POS
+    pedestal = PEDESTAL_RADIUS + HOUSING_PAD
     head_lo = dims.SENSOR_LOW_HEIGHT + 0.03  # top of the low sensors' housings
     head_hi = dims.SENSOR_HIGH_HEIGHT + 0.03
-    cam_x0, cam_x1 = dims.SENSOR_X - 0.045, dims.SENSOR_X + 0.01  # housings behind the lenses
-    cam_z0 = dims.SENSOR_LOW_HEIGHT - 0.06 - 0.025  # under the lower (55 deg) sensor
     return (
         # The deck and everything on it up to the deck's top.
         Box("deck", (x_rear, -half_w, 0.0), (dims.CASTER_X + 0.1, half_w, deck_top)),
@@ -100,30 +181,32 @@ def _keepout() -> tuple[Box, ...]:
         Box("basket_back", (bx0, by0, bz0), (bx0 + w, by1, bz1)),
         Box("basket_left", (bx0, by1 - w, bz0), (bx1, by1, bz1)),
         Box("basket_right", (bx0, by0, bz0), (bx1, by0 + w, bz1)),
-        # The sensor posts: thin poles, the cameras' heads near their tops, and the projector.
+        # The arm's pedestal and the bracket under it. The first link turns on its top.
+        Box(
+            "arm_pedestal",
+            (mx - pedestal, my - pedestal, PEDESTAL_FOOT),
+            (mx + pedestal, my + pedestal, mz),
+            spares=(0,),
+        ),
+        # The sensor posts: thin poles up to the cameras' heads.
         Box(
             "pole_left",
-            (post_x - 0.03, post_y - 0.03, deck_top),
-            (post_x + 0.03, post_y + 0.03, head_hi),
+            (post_x - pole, post_y - pole, deck_top - pole),
+            (post_x + pole, post_y + pole, head_hi),
         ),
         Box(
             "pole_right",
-            (post_x - 0.03, -post_y - 0.03, deck_top),
-            (post_x + 0.03, -post_y + 0.03, head_lo),
+            (post_x - pole, -post_y - pole, deck_top - pole),
+            (post_x + pole, -post_y + pole, head_lo),
         ),
-        # The camera housings near the posts' tops (the high sensor on the left one).
-        Box("heads_left", (cam_x0, post_y - 0.07, cam_z0), (cam_x1, post_y + 0.07, head_lo)),
+        # The projector's bracket from the left post to over the scooter's middle.
         Box(
-            "high_left",
-            (cam_x0 - 0.1, post_y - 0.07, head_hi - 0.1),
-            (cam_x1, post_y + 0.07, head_hi),
+            "projector_bracket",
+            (post_x - 0.03, dims.PROJECTOR_POS[1] - 0.03, dims.PROJECTOR_POS[2]),
+            (post_x + 0.03, post_y, dims.PROJECTOR_POS[2] + 0.06),
         ),
-        Box("heads_right", (cam_x0, -post_y - 0.07, cam_z0), (cam_x1, -post_y + 0.07, head_lo)),
-        Box(
-            "projector",
-            (dims.PROJECTOR_POS[0] - 0.1, dims.PROJECTOR_POS[1] - 0.12, dims.PROJECTOR_POS[2]),
-            (dims.PROJECTOR_POS[0] + 0.1, post_y + 0.02, dims.PROJECTOR_POS[2] + 0.08),
-        ),
+        # Each camera's housing and the projector's, padded.
+        *(h.keepout(HOUSING_PAD) for h in HOUSINGS),
     )
 
 

@@ -46,6 +46,10 @@ UR5_LINK_MASSES = (4.0, 3.7, 8.393, 2.275, 1.219, 1.219, 0.1879)
 UR5_LINK_RADII = (0.075, 0.06, 0.054, 0.045, 0.045, 0.045, 0.04)
 #: Peak joint torques (N m): 150 for the base joints, 28 for the wrists (datasheet sizes).
 UR5_TORQUE_MAX = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
+#: Force from outside on the arm, the hand or what it holds (N) beyond which the controller
+#: makes a protective stop on any motion: a UR controller's default safety limit (150 N).
+#: The guarded approach and lowering stop far sooner (`MotionSettings.guard_force`).
+UR5_PROTECTIVE_STOP_FORCE = 150.0
 
 #: Folded down and back along the scooter's right side, gripper down: out of the depth
 #: cameras' view of the workspace (only right_55 sees part of it) and clear of the basket (rad).

@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 from laserpick.description.collision import (
     FLOOR_CLEARANCE,
     GRIPPER_CAPSULES,
+    HOUSING_CAPSULES,
     KEEPOUT_BOXES,
     LINK_CAPSULES,
     Segment,
@@ -45,9 +46,11 @@ def _spheres(segment: Segment) -> tuple[np.ndarray, float]:
 
 
 def sphere_model() -> SphereModel:
-    """The arm's spheres, built from the shared capsule table."""
+    """The arm's spheres, built from the shared tables of link capsules, joint housings
+    and gripper capsules."""
     body, centre, radius, hand = [], [], [], []
     parts = [(i, seg, False) for i, segs in enumerate(LINK_CAPSULES) for seg in segs]
+    parts += [(i, seg, False) for i, seg in enumerate(HOUSING_CAPSULES)]
     parts += [(6, seg, True) for seg in GRIPPER_CAPSULES]
     for i, seg, is_hand in parts:
         c, r = _spheres(seg)
@@ -63,6 +66,25 @@ def sphere_model() -> SphereModel:
 SPHERES = sphere_model()
 _LO = np.array([b.lo for b in KEEPOUT_BOXES])
 _HI = np.array([b.hi for b in KEEPOUT_BOXES])
+_TURN = np.array([b.turn for b in KEEPOUT_BOXES])  # (K, 3, 3)
+
+
+def _in_boxes(points: np.ndarray) -> np.ndarray:
+    """Points (..., 3) of `base` in each keep-out box's frame: (..., K, 3)."""
+    return np.einsum("...j,kji->...ki", points, _TURN)
+
+
+def _box_gaps(points: np.ndarray) -> np.ndarray:
+    """Distance (m) from points (..., 3) of `base` to each keep-out box, 0 inside: (..., K)."""
+    local = _in_boxes(points)
+    return np.linalg.norm(np.maximum(np.maximum(_LO - local, local - _HI), 0.0), axis=-1)
+
+
+#: (7, K): whether arm body b (0 = link1 ... 6 = the hand, and what it holds) is checked
+#: against keep-out box k.
+_CHECKED = np.array([[b not in box.spares for box in KEEPOUT_BOXES] for b in range(7)])
+#: The body a held object's spheres count as.
+HAND_BODY = 6
 
 
 def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarray:
@@ -185,8 +207,7 @@ def obstacle_mask(
     if q_self is not None:
         idx = idx[self_filter(points[idx], q_self)]
     # The scooter and its rider, where the cameras see them, are the keep-out boxes already.
-    p = np.asarray(points[idx], float)[:, None, :]
-    inside = np.all((p >= _LO - SELF_PADDING) & (p <= _HI + SELF_PADDING), axis=2).any(axis=1)
+    inside = (_box_gaps(np.asarray(points[idx], float)) <= SELF_PADDING).any(axis=1)
     idx = idx[~inside]
     out = np.zeros(len(points), bool)
     out[idx] = True
@@ -259,9 +280,10 @@ class CollisionChecker:
         Q = np.atleast_2d(np.asarray(Q, float))
         frames = body_frames(Q)
         centres = sphere_centres(frames)
-        radius = SPHERES.radius
+        radius, body = SPHERES.radius, SPHERES.body
         if not hand:
-            centres, radius = centres[:, ~SPHERES.hand], radius[~SPHERES.hand]
+            keep = ~SPHERES.hand
+            centres, radius, body = centres[:, keep], radius[keep], body[keep]
         clear = np.ones(len(Q), bool)
         if payload is not None and len(payload):
             T = frames[:, 6] @ T_FLANGE_TCP
@@ -275,18 +297,19 @@ class CollisionChecker:
             clear &= ~(gap < reach).any(axis=(1, 2))
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
-        return clear & ~self._hits(centres, radius, margin).any(axis=1)
+            body = np.append(body, np.full(len(payload), HAND_BODY))
+        return clear & ~self._hits(centres, radius, body, margin).any(axis=1)
 
     def _contacts(
-        self, centres: np.ndarray, radius: np.ndarray, margin: float
+        self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """For spheres (B, S) of `radius` (S,): whether each is below the floor's clearance
-        (B, S), within `margin` of each keep-out box (B, S, K), and of the cloud (B, S)."""
+        """For spheres (B, S) of `radius` (S,) on the arm's `body` (S,): whether each is
+        below the floor's clearance (B, S), within `margin` of each keep-out box that checks
+        its body (B, S, K), and of the cloud (B, S)."""
         B, S, _ = centres.shape
         reach = radius[None, :] + margin
         floor = centres[..., 2] < radius + FLOOR_CLEARANCE
-        gap = np.maximum(_LO - centres[..., None, :], centres[..., None, :] - _HI)
-        boxes = np.linalg.norm(np.maximum(gap, 0.0), axis=-1) < reach[..., None]
+        boxes = (_box_gaps(centres) < reach[..., None]) & _CHECKED[body]
         cloud = np.zeros((B, S), bool)
         if self.tree is not None:
             bound = float(radius.max() + margin)
@@ -294,18 +317,20 @@ class CollisionChecker:
             cloud = d.reshape(B, S) < reach
         return floor, boxes, cloud
 
-    def _hits(self, centres: np.ndarray, radius: np.ndarray, margin: float) -> np.ndarray:
+    def _hits(
+        self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float
+    ) -> np.ndarray:
         """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
-        floor, boxes, cloud = self._contacts(centres, radius, margin)
+        floor, boxes, cloud = self._contacts(centres, radius, body, margin)
         return floor | boxes.any(axis=-1) | cloud
 
     def what_hits(self, q: np.ndarray, *, hand: bool = True) -> list[str]:
         """Names of what configuration q (6,) touches: "floor", a keep-out box, or "cloud"."""
         centres = sphere_centres(body_frames(q))
-        radius = SPHERES.radius
-        if not hand:
-            centres, radius = centres[:, ~SPHERES.hand], radius[~SPHERES.hand]
-        floor, boxes, cloud = self._contacts(centres, radius, self.margin)
+        keep = np.ones(len(SPHERES.radius), bool) if hand else ~SPHERES.hand
+        floor, boxes, cloud = self._contacts(
+            centres[:, keep], SPHERES.radius[keep], SPHERES.body[keep], self.margin
+        )
         names = ["floor"] if floor.any() else []
         names += [b.name for k, b in enumerate(KEEPOUT_BOXES) if boxes[..., k].any()]
         return names + (["cloud"] if cloud.any() else [])

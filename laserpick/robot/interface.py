@@ -14,7 +14,9 @@ import numpy as np
 
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.sim import MotionHandle
+from laserpick.robot.sim import PROTECTIVE_STOP, MotionHandle
+
+__all__ = ["PROTECTIVE_STOP", "GripperState", "JointState", "MotionHandle", "Robot"]
 
 
 @dataclass(frozen=True)

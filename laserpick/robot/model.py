@@ -22,7 +22,15 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.collision import LINK_CAPSULES
+from laserpick.description.collision import (
+    HOUSING_CAPSULES,
+    HOUSINGS,
+    LINK_CAPSULES,
+    PEDESTAL_FOOT,
+    PEDESTAL_RADIUS,
+    POST_BACK,
+    POST_RADIUS,
+)
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT
 from laserpick.robot.scenes import Scene, add_scene_to_spec
 from laserpick.settings import get_settings
@@ -140,11 +148,13 @@ def _add_ur5(parent: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
             if np.allclose(p0, p1):
                 p1 = (p1[0], p1[1], p1[2] + 1e-3)
             _capsule_between(body, ARM_PREFIX + f"link{i + 1}/c{k}", p0, p1, rad, share)
-        # Joint housings: short cylinders along the joint axis, for looks and collision.
-        hous = body.add_geom(
-            name=ARM_PREFIX + f"link{i + 1}/joint", type=G.mjGEOM_CYLINDER, pos=[0, 0, 0]
-        )
-        hous.size = [r[i + 1] * 1.08, 0.06 if i < 3 else 0.045, 0]
+        # The joint's housing, for looks and collision: a ball or a short capsule.
+        _, end, radius = HOUSING_CAPSULES[i]  # centred on the origin, along z
+        hous = body.add_geom(name=ARM_PREFIX + f"link{i + 1}/joint", pos=[0, 0, 0])
+        if end[2] > 0:
+            hous.type, hous.size = G.mjGEOM_CAPSULE, [radius, end[2], 0]
+        else:
+            hous.type, hous.size = G.mjGEOM_SPHERE, [radius, 0, 0]
         hous.rgba = list(JOINT_RGBA)
         hous.group = GROUP_ROBOT
         hous.mass = 0.0
@@ -329,39 +339,19 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
     )
     # Sensor posts: two uprights carrying the four low sensors, the left one taller for the
     # fifth sensor.
-    for mount in dims.CAMERA_MOUNTS:
-        R = rotz(mount.yaw) @ roty(mount.pitch_down)
-        # The housing sits just behind the lens, so the camera never sees its own box.
-        centre = np.array(mount.pos) - R[:, 0] * 0.02
-        _shell(
-            body,
-            f"sensor_{mount.name}",
-            G.mjGEOM_BOX,
-            (0.015, 0.06, 0.015),
-            centre,
-            DARK_RGBA,
-            quat=_quat(R),
-        )
+    # The cameras' and the projector's housings, as the planner's keep-out boxes know them.
+    for h in HOUSINGS:
+        _shell(body, h.name, G.mjGEOM_BOX, h.half, h.centre, DARK_RGBA, quat=_quat(h.R))
     for side, y, top in (
         ("left", dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_HIGH_HEIGHT),
         ("right", -dims.SENSOR_GROUP_SPACING / 2, dims.SENSOR_LOW_HEIGHT),
     ):
-        x = dims.SENSOR_X - 0.1
+        x = dims.SENSOR_X - POST_BACK
         _shell_capsule(
-            body, f"post_{side}", (x, y, dims.SCOOTER_DECK_HEIGHT), (x, y, top - 0.02), 0.015
+            body, f"post_{side}", (x, y, dims.SCOOTER_DECK_HEIGHT), (x, y, top - 0.02), POST_RADIUS
         )
-    # Projector housing on its bracket from the tall left post.
     px, py, pz = dims.PROJECTOR_POS
-    _shell(
-        body,
-        "projector",
-        G.mjGEOM_BOX,
-        (0.06, 0.09, 0.035),
-        (px, py, pz + 0.03),
-        DARK_RGBA,
-        quat=_quat(rotz(dims.PROJECTOR_YAW)),
-    )
-    post_x = dims.SENSOR_X - 0.1
+    post_x = dims.SENSOR_X - POST_BACK
     _shell_capsule(
         body,
         "projector_bracket",
@@ -394,8 +384,8 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
         body,
         "arm_pedestal",
         G.mjGEOM_CYLINDER,
-        (0.07, (mz - 0.15) / 2),
-        (mx, my, 0.15 + (mz - 0.15) / 2),
+        (PEDESTAL_RADIUS, (mz - PEDESTAL_FOOT) / 2),
+        (mx, my, (mz + PEDESTAL_FOOT) / 2),
         DARK_RGBA,
     )
     _shell(

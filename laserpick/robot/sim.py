@@ -38,6 +38,8 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 
 #: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
 _CHUNK_STEPS = 10
+#: How a motion's message begins when a protective stop ended it.
+PROTECTIVE_STOP = "protective stop: "
 
 
 class MotionHandle:
@@ -384,16 +386,13 @@ class Simulation:
                     for event in motion.due_events(d.time):
                         self._grip_closed = event.action == "close"
                         self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
-                    guard = motion.traj.guard_force
-                    if guard is not None:
-                        contacts = self._arm_contacts()
-                        if sum(f for f, _, _ in contacts) > guard:
-                            report = self._contact_report(contacts)
-                            self._halt("failed", f"unexpected contact: {report}")
-                            return
+                    if self._stopped_by_contact(motion.traj.guard_force):
+                        return
                     if motion.finished(d.time):
                         self._end_motion("done")
                 else:
+                    if self._stopped_by_contact(None):
+                        return
                     q = d.qpos[info.arm_qpos].copy()
                     self._q_set = motion.step(self._q_set, dt)
                     pos_err, rot_err = motion.error(q)
@@ -434,6 +433,20 @@ class Simulation:
         if self._handle is not None:
             self._handle._finish(status, message)
         self._motion, self._handle = None, None
+
+    def _stopped_by_contact(self, guard_force: float | None) -> bool:
+        """Stop the motion where the force from outside on the arm passes its guard (N), or
+        on any motion the protective stop's limit: the UR5 controller stops every motion it
+        feels pushed back that hard, planned around what it was shown or not."""
+        contacts = self._arm_contacts()
+        total = sum(f for f, _, _ in contacts)
+        if guard_force is not None and total > guard_force:
+            self._halt("failed", f"unexpected contact: {self._contact_report(contacts)}")
+            return True
+        if total > dims.UR5_PROTECTIVE_STOP_FORCE:
+            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts))
+            return True
+        return False
 
     def _halt(self, status: MotionStatus, message: str) -> None:
         """Hold the arm where it is and stop the base, at once."""
