@@ -514,7 +514,23 @@ class Behaviours:
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
         self.progress("Released into the basket.")
-        return self.go_ready(held.surroundings)
+        # The open hand rises off the object before it turns away: a tall bottle stands up
+        # out of the basket, and a straight way to ready swept the fingers through it (152 N,
+        # a protective stop). The object can only have fallen from where the hand let go.
+        T = tcp_pose(self._q())
+        let_go = held.points_tcp @ T[:3, :3].T + T[:3, 3]
+        around = CollisionChecker(
+            np.vstack([held.surroundings.points, let_go]),
+            margin=self.settings.motion.clearance,
+            filtered=True,
+        )
+        failure = self._rise_clear(around, hand_on_the_way=False)
+        if failure is not None:
+            return Outcome(failure)
+        back = self.go_ready(around)
+        if back.failure is not None and back.failure.kind == "ik_plan":
+            return self.go_ready(held.surroundings)  # no way around it: as it fell, lower
+        return back
 
     def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
         """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).
