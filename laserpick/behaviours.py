@@ -67,6 +67,8 @@ START_WAIT = 1.0
 START_STUCK = 0.05
 #: Extra time (s) a motion may take beyond its planned duration before it counts as failed.
 MOTION_SLACK = 3.0
+#: Spacing (rad, largest joint) of the waypoints kept on the way back from a protective stop.
+BACK_STEP = 0.1
 
 
 def turned_hand_xy(spot_xy: np.ndarray, middle_xy: np.ndarray, dyaw: float) -> np.ndarray:
@@ -198,8 +200,27 @@ class Behaviours:
             return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
         if handle.message.startswith(PROTECTIVE_STOP):
             felt = handle.message.removeprefix(PROTECTIVE_STOP)
-            return Failure("execute", f"The arm was pushed back while {what} ({felt}): stopped.")
+            done = "stopped and backed away" if self._back_away(traj) else "stopped"
+            return Failure("execute", f"The arm was pushed back while {what} ({felt}): {done}.")
         return Failure("execute", f"The arm stopped while {what}: {handle.message}.")
+
+    def _back_away(self, traj: Trajectory) -> bool:
+        """After a protective stop on `traj`, go back the way it came to where it started:
+        the arm was there a moment ago, so that way is clear, and the arm is then neither
+        pressed against what it met nor left standing in the cameras' view (left there, it
+        hid the next mark's object from them). Returns whether it got back."""
+        q = self._q()
+        reached = int(np.argmin(np.max(np.abs(traj.q - q), axis=1)))
+        back = np.vstack([q, traj.q[reached::-1]])
+        # Keep the turning points, about BACK_STEP apart: a trajectory is sampled densely.
+        moved = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(back, axis=0)), axis=1))])
+        keep = np.flatnonzero(np.diff(np.floor(moved / BACK_STEP), prepend=-1) > 0)
+        path = back[np.union1d(keep, [len(back) - 1])]
+        if len(path) < 2 or np.max(np.abs(path[-1] - q)) < START_TOLERANCE:
+            return True
+        way_back = timed(path, self.settings.motion)
+        handle = self.robot.execute(way_back)
+        return self.robot.wait(handle, way_back.duration + MOTION_SLACK) == "done"
 
     def _q(self) -> np.ndarray:
         return self.robot.joint_state().q

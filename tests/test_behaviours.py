@@ -72,25 +72,29 @@ def test_guarded_trajectory_stops_on_contact(robot):
     assert tcp_z > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
 
 
-def test_any_motion_pushed_back_hard_makes_a_protective_stop(robot):
+def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robot):
     """An unguarded joint move that drives the hand down through the table (as a transit
-    planned through unseen furniture would) is stopped by the protective stop, and the
-    behaviour says so in words."""
+    planned through unseen furniture would) is stopped by the protective stop; the arm goes
+    back the way it came, and the behaviour says so in words."""
     b = Behaviours(robot)
     assert b.go_ready().ok
     T_low = tcp_pose(dims.UR5_READY_Q)
     T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.15]  # 15 cm into the table
     q_low = ik_tcp(T_low, dims.UR5_READY_Q)[0]
-    failure = b._run(timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion), "testing")
+    move = timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion)
+    lowest = []
+    robot.sim.on_snapshot(lambda snap: lowest.append(tcp_pose(snap.arm_q)[2, 3]))
+    failure = b._run(move, "testing")
     assert failure is not None and failure.kind == "execute"
     assert failure.message.startswith("The arm was pushed back while testing (")
     assert " met surface/table" in failure.message
+    assert failure.message.endswith("stopped and backed away.")
+    assert min(lowest) > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
     robot.sleep(0.3)
     s = robot.sim.snapshot()
-    assert np.abs(s.arm_qd).max() < 0.05, "the arm must be at rest after the stop"
-    assert tcp_pose(s.arm_q)[2, 3] > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
+    assert np.abs(s.arm_qd).max() < 0.05, "the arm must be at rest after backing away"
+    assert np.max(np.abs(s.arm_q - dims.UR5_READY_Q)) < 0.05, "back where the move started"
     # It stops on the push, not before: the same move above the table finishes.
-    assert b.go_ready().ok
     T_low[2, 3] = TABLE_TOP + 0.15
     q_high = ik_tcp(T_low, dims.UR5_READY_Q)[0]
     assert b._run(timed(np.stack([robot.joint_state().q, q_high]), b.settings.motion), "") is None
