@@ -71,7 +71,8 @@ GRIPPER_CAPSULES: tuple[Segment, ...] = (
 )
 
 
-_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+#: The rotation of an axis-aligned box.
+IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,7 @@ class Box:
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
     spares: tuple[int, ...] = ()
-    turn: tuple[tuple[float, float, float], ...] = _IDENTITY
+    turn: tuple[tuple[float, float, float], ...] = IDENTITY
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from laserpick.description.collision import (
     FLOOR_CLEARANCE,
     GRIPPER_CAPSULES,
     HOUSING_CAPSULES,
+    IDENTITY,
     KEEPOUT_BOXES,
     LINK_CAPSULES,
     Segment,
@@ -40,9 +41,11 @@ class SphereModel:
 
 def _spheres(segment: Segment) -> tuple[np.ndarray, float]:
     a, b, r = np.asarray(segment[0], float), np.asarray(segment[1], float), segment[2]
-    n = max(2, math.ceil(np.linalg.norm(b - a) / r) + 1)
-    spacing = np.linalg.norm(b - a) / (n - 1)
-    return np.linspace(a, b, n), math.hypot(r, spacing / 2)
+    length = float(np.linalg.norm(b - a))
+    if length == 0.0:  # a ball: a joint housing
+        return a[None], r
+    n = max(2, math.ceil(length / r) + 1)
+    return np.linspace(a, b, n), math.hypot(r, length / (n - 1) / 2)
 
 
 def sphere_model() -> SphereModel:
@@ -66,18 +69,26 @@ def sphere_model() -> SphereModel:
 SPHERES = sphere_model()
 _LO = np.array([b.lo for b in KEEPOUT_BOXES])
 _HI = np.array([b.hi for b in KEEPOUT_BOXES])
-_TURN = np.array([b.turn for b in KEEPOUT_BOXES])  # (K, 3, 3)
+_TURNED = np.flatnonzero([b.turn != IDENTITY for b in KEEPOUT_BOXES])
+_ALIGNED = np.setdiff1d(np.arange(len(KEEPOUT_BOXES)), _TURNED)
+#: (3, 3 * turned): one product takes a point into every turned box's axes at once.
+_INTO_TURNED = np.array([KEEPOUT_BOXES[k].turn for k in _TURNED]).transpose(1, 0, 2).reshape(3, -1)
 
 
-def _in_boxes(points: np.ndarray) -> np.ndarray:
-    """Points (..., 3) of `base` in each keep-out box's frame: (..., K, 3)."""
-    return np.einsum("...j,kji->...ki", points, _TURN)
+def _gaps(local: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Distance from points (..., K, 3) in K boxes' axes to boxes lo..hi (K, 3), 0 inside."""
+    gap = np.maximum(np.maximum(lo - local, local - hi), 0.0)
+    return np.sqrt(np.einsum("...i,...i->...", gap, gap))
 
 
 def _box_gaps(points: np.ndarray) -> np.ndarray:
-    """Distance (m) from points (..., 3) of `base` to each keep-out box, 0 inside: (..., K)."""
-    local = _in_boxes(points)
-    return np.linalg.norm(np.maximum(np.maximum(_LO - local, local - _HI), 0.0), axis=-1)
+    """Distance (m) from points (..., 3) of `base` to each keep-out box, 0 inside: (..., K).
+    Only the few turned boxes take the points into their own axes."""
+    out = np.empty((*points.shape[:-1], len(KEEPOUT_BOXES)))
+    out[..., _ALIGNED] = _gaps(points[..., None, :], _LO[_ALIGNED], _HI[_ALIGNED])
+    turned = (points @ _INTO_TURNED).reshape(*points.shape[:-1], len(_TURNED), 3)
+    out[..., _TURNED] = _gaps(turned, _LO[_TURNED], _HI[_TURNED])
+    return out
 
 
 #: (7, K): whether arm body b (0 = link1 ... 6 = the hand, and what it holds) is checked
