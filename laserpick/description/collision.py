@@ -79,8 +79,8 @@ IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 class Box:
     """A keep-out box: lower and upper corners (m) along its own axes, the columns of the
     rotation `turn` (identity: axis-aligned in `base`); a point p of `base` lies in it where
-    lo <= turn.T @ p <= hi. `spares`: the arm's bodies (0 = link1 ... 6 =
-    the hand) not checked against it, as the first link standing on the arm's pedestal."""
+    lo <= turn.T @ p <= hi. `spares`: the arm's bodies (0 = link1 ... 6 = the hand) not
+    checked against it, as the first link standing on the arm's pedestal."""
 
     name: str
     lo: tuple[float, float, float]
@@ -182,7 +182,7 @@ def _keepout() -> tuple[Box, ...]:
         Box("basket_back", (bx0, by0, bz0), (bx0 + w, by1, bz1)),
         Box("basket_left", (bx0, by1 - w, bz0), (bx1, by1, bz1)),
         Box("basket_right", (bx0, by0, bz0), (bx1, by0 + w, bz1)),
-        # The arm's pedestal and the bracket under it. The first link turns on its top.
+        # The arm's pedestal: the first link turns on its top.
         Box(
             "arm_pedestal",
             (mx - pedestal, my - pedestal, PEDESTAL_FOOT),

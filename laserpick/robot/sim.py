@@ -107,8 +107,12 @@ class Simulation:
         self.model = build_sim_model(scene)
         self.data = mujoco.MjData(self.model)
         self.info = ModelInfo.of(self.model)
-        self._arm_geoms = frozenset(self.info.arm_geoms.tolist())
-        self._pad_geoms = frozenset(self.info.pad_geoms.tolist())
+        # Which geoms are the arm's (gripper and pads included), and which the pads: masks
+        # over the model's geoms, as the contact checks of every control tick use them.
+        self._arm_geoms = np.zeros(self.model.ngeom, bool)
+        self._arm_geoms[self.info.arm_geoms] = True
+        self._pad_geoms = np.zeros(self.model.ngeom, bool)
+        self._pad_geoms[self.info.pad_geoms] = True
         self.arm_model = build_arm_model()
         self._cartesian = CartesianController(self.arm_model)
         self.dt = float(self.model.opt.timestep)
@@ -469,21 +473,24 @@ class Simulation:
         return False
 
     def _contacts(
-        self, geoms: frozenset[int], *, from_outside: bool = False
+        self, geoms: np.ndarray, *, from_outside: bool = False
     ) -> list[tuple[float, int, int]]:
-        """(normal force (N), geom among `geoms`, the other geom) of each contact touching
-        any of `geoms`; from_outside: only those between one of `geoms` and one not among
-        them."""
+        """(normal force (N), geom among `geoms` (a mask over the model's geoms), the other
+        geom) of each contact touching any of `geoms`; from_outside: only those between one
+        of `geoms` and one not among them."""
         d = self.data
+        if d.ncon == 0:
+            return []
+        # Every motion checks this every control tick: find the few contacts that touch
+        # `geoms` in one vectorized pass, and ask MuJoCo for the force of those only.
+        pairs = d.contact.geom  # (ncon, 2)
+        a, b = geoms[pairs[:, 0]], geoms[pairs[:, 1]]
         out = []
         force = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            a, b = c.geom1 in geoms, c.geom2 in geoms
-            if (a != b) if from_outside else (a or b):
-                mujoco.mj_contactForce(self.model, d, i, force)
-                ours, other = (c.geom1, c.geom2) if a else (c.geom2, c.geom1)
-                out.append((abs(float(force[0])), int(ours), int(other)))
+        for i in np.flatnonzero((a != b) if from_outside else (a | b)):
+            mujoco.mj_contactForce(self.model, d, int(i), force)
+            ours, other = pairs[i] if a[i] else pairs[i, ::-1]
+            out.append((abs(float(force[0])), int(ours), int(other)))
         return out
 
     def _gripper_force(self) -> float:
@@ -496,19 +503,16 @@ class Simulation:
         estimate or a wrist force sensor would read. The grip itself (the pads on the held
         object) is internal and not counted: counted, it tripped every guarded place at once,
         and the object was let go from 10 cm up."""
-        if not self._grip_closed:
+        if not self._grip_closed or self.data.ncon == 0:
             return self._contacts(self._arm_geoms)
-        d, m = self.data, self.model
-        held_bodies = set()
-        for i in range(d.ncon):
-            c = d.contact[i]
-            if c.geom1 in self._pad_geoms or c.geom2 in self._pad_geoms:
-                other = c.geom2 if c.geom1 in self._pad_geoms else c.geom1
-                held_bodies.add(int(m.geom_bodyid[other]))
-        if not held_bodies:
+        m, pairs = self.model, self.data.contact.geom
+        on_pad = self._pad_geoms[pairs]
+        touched = np.where(on_pad[:, 0], pairs[:, 1], pairs[:, 0])[on_pad.any(axis=1)]
+        if len(touched) == 0:
             return self._contacts(self._arm_geoms)
-        held = np.flatnonzero(np.isin(m.geom_bodyid, list(held_bodies)))
-        return self._contacts(self._arm_geoms | frozenset(held.tolist()), from_outside=True)
+        # The held object: every geom of the bodies the pads touch.
+        held = np.isin(m.geom_bodyid, m.geom_bodyid[touched])
+        return self._contacts(self._arm_geoms | held, from_outside=True)
 
     def _contact_report(self, contacts: list[tuple[float, int, int]]) -> str:
         """'{N} N on the arm, most where {body} met {body}': what a guarded stop says."""
