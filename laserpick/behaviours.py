@@ -208,7 +208,10 @@ class Behaviours:
         """After a protective stop on `traj`, go back the way it came to where it started:
         the arm was there a moment ago, so that way is clear, and the arm is then neither
         pressed against what it met nor left standing in the cameras' view (left there, it
-        hid the next mark's object from them). Returns whether it got back."""
+        hid the next mark's object from them). Not when the user has cancelled: the arm then
+        stays where it stopped. Returns whether it got back."""
+        if self.should_stop():
+            return False
         q = self._q()
         reached = int(np.argmin(np.max(np.abs(traj.q - q), axis=1)))
         back = np.vstack([q, traj.q[reached::-1]])
