@@ -159,6 +159,7 @@ def _keepout() -> tuple[Box, ...]:
     pole = POST_RADIUS + HOUSING_PAD
     mx, my, mz = dims.ARM_MOUNT_POS
     pedestal = PEDESTAL_RADIUS + HOUSING_PAD
+    bracket_z = dims.PROJECTOR_POS[2] + PROJECTOR_HOUSING_RAISE  # the projector's bracket
     head_lo = dims.SENSOR_LOW_HEIGHT + 0.03  # top of the low sensors' housings
     head_hi = dims.SENSOR_HIGH_HEIGHT + 0.03
     return (
@@ -203,8 +204,8 @@ def _keepout() -> tuple[Box, ...]:
         # The projector's bracket from the left post to over the scooter's middle.
         Box(
             "projector_bracket",
-            (post_x - 0.03, dims.PROJECTOR_POS[1] - 0.03, dims.PROJECTOR_POS[2]),
-            (post_x + 0.03, post_y, dims.PROJECTOR_POS[2] + 0.06),
+            (post_x - 0.03, dims.PROJECTOR_POS[1] - 0.03, bracket_z - 0.03),
+            (post_x + 0.03, post_y, bracket_z + 0.03),
         ),
         # Each camera's housing and the projector's, padded.
         *(h.keepout(HOUSING_PAD) for h in HOUSINGS),

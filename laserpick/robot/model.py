@@ -30,6 +30,7 @@ from laserpick.description.collision import (
     PEDESTAL_RADIUS,
     POST_BACK,
     POST_RADIUS,
+    PROJECTOR_HOUSING_RAISE,
 )
 from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT
 from laserpick.robot.scenes import Scene, add_scene_to_spec
@@ -350,13 +351,14 @@ def _add_scooter_shell(body: mujoco.MjsBody) -> None:
         _shell_capsule(
             body, f"post_{side}", (x, y, dims.SCOOTER_DECK_HEIGHT), (x, y, top - 0.02), POST_RADIUS
         )
+    # The projector's bracket, from the tall post to the projector's housing at its height.
     px, py, pz = dims.PROJECTOR_POS
-    post_x = dims.SENSOR_X - POST_BACK
+    bracket_z = pz + PROJECTOR_HOUSING_RAISE
     _shell_capsule(
         body,
         "projector_bracket",
-        (post_x, dims.SENSOR_GROUP_SPACING / 2, pz + 0.03),
-        (px, py, pz + 0.03),
+        (dims.SENSOR_X - POST_BACK, dims.SENSOR_GROUP_SPACING / 2, bracket_z),
+        (px, py, bracket_z),
         0.012,
     )
     # Basket: a floor and four walls, open at the top.
