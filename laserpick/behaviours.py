@@ -279,19 +279,28 @@ class Behaviours:
         return self.go_to(dims.UR5_READY_Q, checker, "going to ready", via=(dims.UR5_HIGH_READY_Q,))
 
     def stow(self, checker: CollisionChecker | None = None) -> Outcome:
-        """Fold the arm down beside the scooter, out of the cameras' view, through ready.
-        checker: what stands around the arm, when a fresh cloud shows it (see `go_ready`)."""
+        """Fold the arm down beside the scooter, out of the cameras' view: through ready,
+        then the way out of the stowed pose backwards (`_fold_away`). checker: what stands
+        around the arm, when a fresh cloud shows it (see `go_ready`)."""
         if np.max(np.abs(self._q() - dims.UR5_HOME_Q)) < 0.05:
             return Outcome()
         out = self.go_ready(checker)
         if out.failure is not None and out.failure.kind == "ik_plan" and checker is not None:
             # No way to either ready pose (the hand set an object down on the 108 cm table,
             # which fills both): fold away from where it is, by a checked search.
-            direct = self.go_to(dims.UR5_HOME_Q, checker, "stowing")
+            direct = self._fold_away(checker)
             return direct if direct.ok else out
         if not out.ok:
             return out
-        return self.go_to(dims.UR5_HOME_Q, checker or CollisionChecker(np.zeros((0, 3))), "stowing")
+        return self._fold_away(checker)
+
+    def _fold_away(self, checker: CollisionChecker | None = None) -> Outcome:
+        """To the unstow pose, then straight home: the way out of the stowed pose, backwards,
+        which keeps the hand beside the scooter (`dims.UR5_UNSTOW_Q`). checker: what stands
+        around the arm (none: an empty cloud; the scooter is always checked)."""
+        checker = checker or CollisionChecker(np.zeros((0, 3)))
+        out = self.go_to(dims.UR5_UNSTOW_Q, checker, "stowing")
+        return out if not out.ok else self.go_to(dims.UR5_HOME_Q, checker, "stowing")
 
     # --- pick ------------------------------------------------------------------------------
 

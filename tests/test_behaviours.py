@@ -202,6 +202,18 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     robot.sleep(1.0)
     assert referee.in_basket(name)
     assert not robot.gripper_state().closed
+    # Then home, the way it came out: through the unstow pose.
+    passed: list[float] = []
+    execute = robot.execute
+
+    def recording(traj):
+        passed.append(float(np.abs(traj.q - dims.UR5_UNSTOW_Q).max(axis=1).min()))
+        return execute(traj)
+
+    robot.execute = recording  # type: ignore[method-assign]
+    assert b.stow().ok
+    assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
+    assert min(passed) < 0.01
 
 
 def _pick(robot: SimRobot, name: str) -> tuple[Behaviours, Referee]:

@@ -337,6 +337,34 @@ def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
     assert v.max() <= s.approach_speed * 1.05
 
 
+def test_from_the_stowed_arm_the_transit_goes_out_through_the_unstow_pose():
+    """Home, the unstow pose, ready, the pre-grasp: the way out of the stowed pose is the
+    same straight move for every grasp, and it is left out where the cloud fills the
+    unstow pose."""
+    s = get_settings().motion
+    world = CollisionChecker(table())
+    q_grasp = ik_tcp(top_grasp(1.55, -0.25, 0.50, yaw=0.4), dims.UR5_READY_Q)[0]
+    home, unstow, ready = dims.UR5_HOME_Q, dims.UR5_UNSTOW_Q, dims.UR5_READY_Q
+    rng = np.random.default_rng(0)
+    plan = plan_pick(home, q_grasp, world, world, rng, s, via=(ready,), unstow=unstow)
+    assert not isinstance(plan, Failure), plan
+    gap = [np.abs(plan.transit.q - q).max(axis=1) for q in (unstow, ready)]
+    passed = [int(np.argmin(g)) for g in gap]
+    assert max(g.min() for g in gap) < 0.01 and passed[0] < passed[1]  # timed: a blend
+    # The first leg is the straight joint move between the two poses.
+    out = plan.transit.q[: passed[0] + 1]
+    along = (out - home) @ (unstow - home) / np.dot(unstow - home, unstow - home)
+    assert np.allclose(home + along[:, None] * (unstow - home), out, atol=0.01)
+    # A point where the unstow pose's wrist would be (something stands just ahead of the
+    # scooter's corner).
+    corner = body_frames(unstow)[0, 6, :3, 3]
+    blocked = CollisionChecker(np.vstack([table(), corner[None]]), voxel=0.0)
+    assert not blocked.clearance_ok(unstow)[0]
+    plan = plan_pick(home, q_grasp, blocked, blocked, rng, s, via=(ready,), unstow=unstow)
+    assert not isinstance(plan, Failure), plan
+    assert np.abs(plan.transit.q - unstow).max(axis=1).min() > 0.05
+
+
 def test_under_a_board_the_lift_is_the_low_one_and_under_a_lower_one_none():
     """A board above the arm that the full lift would reach leaves the low lift; one that
     even the low lift would reach leaves none."""

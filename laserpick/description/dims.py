@@ -54,6 +54,15 @@ UR5_PROTECTIVE_STOP_FORCE = 150.0
 #: Folded down and back along the scooter's right side, gripper down: out of the depth
 #: cameras' view of the workspace (only right_55 sees part of it) and clear of the basket (rad).
 UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
+#: The way out of the stowed pose and back: just ahead of the scooter's front right corner,
+#: elbow still down as at home, gripper down, the TCP at about (1.20, -0.55, 0.80) in `base`.
+#: The space beside the scooter is space no depth camera sees. The straight joint move from
+#: home keeps the hand (TCP) within 0.34 m of the scooter's side and 0.15 m of its front; the
+#: straight moves on to the ready poses turn the elbow over in front, the hand up to 1.22 m
+#: high and 0.66 m ahead. All three are clear of the scooter. The move to ready straight from
+#: home turned it over out to the side instead, the hand 0.57 m out and 0.68 m ahead, into
+#: furniture the cameras had not seen (rad).
+UR5_UNSTOW_Q = np.array([-1.773, -0.338, -1.967, 0.734, -1.571, -0.203])
 #: Holding an object while the user drives and marks where it goes (pick and place): folded
 #: back along the scooter's right side, gripper down, the TCP at about (0.90, -0.65, 0.95) in
 #: `base`. The upper arm stays behind the sensor posts (x <= 1.10) and the whole arm within

@@ -1,6 +1,7 @@
 """Arm collision checks for planning (paper 004 section 7): the UR5 and its gripper as chains
 of spheres, tested against the fused cloud (a KD-tree of voxel-thinned points), the keep-out
-boxes around the scooter and its rider, and the floor.
+boxes around the scooter and its rider, and the floor; on planned transits, also against the
+space no camera saw (`CollisionChecker.clearance_ok(seen=True)`).
 
 Spheres cover the capsules of `description/collision.py` (a capsule of radius r as spheres at
 most r apart, each grown to cover the waist between neighbours). Frames: `base`, metres.
@@ -8,7 +9,9 @@ most r apart, each grown to cover the waist between neighbours). Frames: `base`,
 
 from __future__ import annotations
 
+import copy
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,9 +27,11 @@ from laserpick.description.collision import (
     Segment,
     body_frames,
 )
-from laserpick.description.dims import ARM_MOUNT_POS, UR5_D
+from laserpick.description.dims import ARM_MOUNT_POS, UR5_D, UR5_HOME_Q, UR5_UNSTOW_Q
 from laserpick.description.kinematics import T_FLANGE_TCP
 from laserpick.pipeline.cloud import voxel_first
+from laserpick.pipeline.free_space import seen_free
+from laserpick.pipeline.types import DepthFrame
 
 
 @dataclass(frozen=True)
@@ -119,6 +124,30 @@ CARRIED_TOP_BAND = 0.02
 PAYLOAD_CLEAR_OF_BODY = 3
 #: A joint segment's every this-many-th configuration is checked before the rest.
 SEGMENT_COARSE = 8
+#: Space within this much (m) of where the arm's spheres were when the frames were captured,
+#: or of where the hand passes on the way out of the stowed pose, counts as seen.
+OWN_SPACE_PADDING = 0.02
+#: A camera saw a point free when its reading lies this far (m) beyond it: three times the
+#: sensors' depth noise at 1.2 m, as for the fingers' free-space test.
+SEEN_TOLERANCE = 0.006
+#: Where a sphere is tested for seen space, in radii from its centre: the centre, and its
+#: surface along each axis of `base`.
+_SPHERE_PROBES = np.vstack([np.zeros(3), np.eye(3), -np.eye(3)])
+
+
+def _unstow_box() -> tuple[np.ndarray, np.ndarray]:
+    """The box (lo, hi; `base`, m) around the hand's spheres on the straight joint move from
+    the stowed pose to the unstow pose, grown by OWN_SPACE_PADDING: the scooter's own side,
+    which no camera sees and the hand must pass (the user keeps it clear, as a scooter
+    user keeps clear the side the arm folds out on)."""
+    Q = np.linspace(UR5_HOME_Q, UR5_UNSTOW_Q, 40)
+    centres = sphere_centres(body_frames(Q))[:, SPHERES.hand].reshape(-1, 3)
+    r = np.tile(SPHERES.radius[SPHERES.hand], len(Q))[:, None]
+    pad = OWN_SPACE_PADDING
+    return (centres - r).min(axis=0) - pad, (centres + r).max(axis=0) + pad
+
+
+UNSTOW_BOX = _unstow_box()
 
 
 def thin(points: np.ndarray, voxel: float) -> np.ndarray:
@@ -225,6 +254,29 @@ def obstacle_mask(
     return out
 
 
+class _OwnSpace:
+    """Space the arm fills, as spheres (centres (N, 3), `base`, m; reach (N,) m)."""
+
+    #: Each point is tested against this many nearest centres: the spheres overlap, so one
+    #: that holds a point is among its nearest; a miss only counts the point unseen.
+    NEAREST = 24
+
+    def __init__(self, centres: np.ndarray, reach: np.ndarray):
+        self.centres, self.reach = centres, reach
+        self._tree = cKDTree(centres) if len(centres) else None
+
+    def holds(self, points: np.ndarray) -> np.ndarray:
+        """(P,) whether each point (P, 3) lies within some sphere's reach."""
+        if self._tree is None or not len(points):
+            return np.zeros(len(points), bool)
+        k = min(self.NEAREST, len(self.centres))
+        d, j = self._tree.query(points, k=k, distance_upper_bound=float(self.reach.max()))
+        d, j = d.reshape(len(points), k), j.reshape(len(points), k)
+        inside = np.isfinite(d)
+        inside[inside] = d[inside] <= self.reach[j[inside]]
+        return inside.any(axis=1)
+
+
 class CollisionChecker:
     """Is the arm clear of the cloud, the scooter and the floor at these joint angles?
 
@@ -232,7 +284,9 @@ class CollisionChecker:
     rest thinned to one per `voxel` (m) for the KD-tree. margin: clearance (m) kept from
     every obstacle on top of the spheres' radii. q_self: the arm's joint angles when the
     points were captured, to filter out the arm's own points. filtered: the points have
-    been through `obstacle_mask` already (voxel and q_self are then unused).
+    been through `obstacle_mask` already (voxel is then unused). frames: the depth frames
+    the points came from, for the seen-space test of planned transits (none: every space
+    counts as seen, as before the test; q_self then says where the arm stood in them).
     """
 
     def __init__(
@@ -243,6 +297,7 @@ class CollisionChecker:
         voxel: float = 0.01,
         q_self: np.ndarray | None = None,
         filtered: bool = False,
+        frames: Sequence[DepthFrame] = (),
     ):
         pts = np.asarray(obstacles, float).reshape(-1, 3)
         if not filtered:  # `filtered`: the points already passed obstacle_mask
@@ -250,6 +305,9 @@ class CollisionChecker:
         self.points = pts
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.margin = margin
+        self.frames = tuple(frames)
+        own = np.zeros((0, 3)) if q_self is None else sphere_centres(body_frames(q_self))[0]
+        self._own = _OwnSpace(own, SPHERES.radius[: len(own)] + OWN_SPACE_PADDING)
 
     @classmethod
     def world_and_surroundings(
@@ -260,15 +318,17 @@ class CollisionChecker:
         margin: float = 0.01,
         voxel: float = 0.01,
         q_self: np.ndarray | None = None,
+        frames: Sequence[DepthFrame] = (),
     ) -> tuple[CollisionChecker, CollisionChecker]:
         """Checkers for the whole cloud and for the cloud without the `target` (indices),
-        sharing one pass of cropping, thinning and self filtering."""
+        sharing one pass of cropping, thinning and self filtering. The whole cloud's checker
+        is the one transits are planned with: it alone gets the frames."""
         pts = np.asarray(points, float).reshape(-1, 3)
         keep = obstacle_mask(pts, voxel=voxel, q_self=q_self)
         others = keep.copy()
         others[target] = False
         return (
-            cls(pts[keep], margin=margin, filtered=True),
+            cls(pts[keep], margin=margin, filtered=True, q_self=q_self, frames=frames),
             cls(pts[others], margin=margin, filtered=True),
         )
 
@@ -279,13 +339,18 @@ class CollisionChecker:
         hand: bool = True,
         payload: np.ndarray | None = None,
         margin: float | None = None,
+        seen: bool = False,
     ) -> np.ndarray:
         """(B,) True where configuration Q[b] (B, 6) (rad) collides with nothing.
 
         hand: include the gripper's spheres (grasp detection already checked the hand at the
         grasp itself). payload: a held object's points (P, 3) in the TCP frame (m), each a
         sphere of PAYLOAD_POINT_RADIUS carried with the hand. margin: overrides the
-        checker's clearance (m).
+        checker's clearance (m). seen: also keep the hand and what it holds where the
+        cameras saw through (`unseen`): a planned transit may not take space no camera saw
+        for free. The hand is what swings out into the room, into furniture beyond the
+        cameras' view (a bookshelf's board); the shoulder and upper arm stay below and beside
+        the sensor posts, where no camera looks, so they are not held to it.
         """
         margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -309,7 +374,44 @@ class CollisionChecker:
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
             body = np.append(body, np.full(len(payload), HAND_BODY))
-        return clear & ~self._hits(centres, radius, body, margin).any(axis=1)
+        clear &= ~self._hits(centres, radius, body, margin).any(axis=1)
+        rows = np.flatnonzero(clear) if seen and self.frames else np.zeros(0, int)
+        if len(rows):  # only the configurations still clear: this projects into every camera
+            out = body == HAND_BODY
+            spheres = centres[rows][:, out].reshape(-1, 3)
+            blind = self.unseen(spheres, np.tile(radius[out], len(rows)))
+            clear[rows[blind.reshape(len(rows), -1).any(axis=1)]] = False
+        return clear
+
+    def knowing(self, *Q: np.ndarray) -> CollisionChecker:
+        """This checker, with the arm's spheres at configurations Q (6,) (rad) counted as seen
+        too, as where it stood at capture: a leg's ends, where the arm stands before it and
+        must stand after (a pre-grasp beside the cameras' view, checked against the cloud)."""
+        out = copy.copy(self)
+        centres = sphere_centres(body_frames(np.array(Q, float))).reshape(-1, 3)
+        reach = np.tile(SPHERES.radius + OWN_SPACE_PADDING, len(Q))
+        own = self._own
+        out._own = _OwnSpace(np.vstack([own.centres, centres]), np.append(own.reach, reach))
+        return out
+
+    def unseen(self, centres: np.ndarray, radius: np.ndarray) -> np.ndarray:
+        """(N,) whether each sphere (centres (N, 3), `base`, m; radius (N,) m) reaches into
+        space no camera saw, tested at its centre and the six points of its surface along
+        `base`'s axes. A point counts as seen where a camera saw past it (by SEEN_TOLERANCE),
+        inside the arm's own spheres as the frames were captured (grown by
+        OWN_SPACE_PADDING: the arm stood there, so nothing else did), or inside UNSTOW_BOX.
+        Points, not whole spheres, so that a sphere may straddle two of these. False for all
+        without frames."""
+        if not self.frames or not len(centres):
+            return np.zeros(len(centres), bool)
+        points = (centres[:, None] + radius[:, None, None] * _SPHERE_PROBES).reshape(-1, 3)
+        lo, hi = UNSTOW_BOX
+        blind = ~((points >= lo) & (points <= hi)).all(axis=1)
+        i = np.flatnonzero(blind)
+        blind[i[seen_free(points[i], self.frames, SEEN_TOLERANCE)]] = False
+        i = np.flatnonzero(blind)
+        blind[i[self._own.holds(points[i])]] = False
+        return blind.reshape(len(centres), -1).any(axis=1)
 
     def _contacts(
         self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float

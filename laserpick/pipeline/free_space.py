@@ -29,11 +29,15 @@ PROBE_DOWN = (0.15, 0.5, 0.85)
 MIN_RANGE = 0.1
 
 
-def seen_free(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -> np.ndarray:
+def seen_free(
+    points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float | np.ndarray
+) -> np.ndarray:
     """(N,) bool: whether some camera saw past each point (N, 3) (m, `base`), its reading at
-    the point's pixel more than `tolerance` (m) beyond the point's own depth. A pixel that
-    read nothing (0) shows nothing: nothing was seen there, near or far."""
+    the point's pixel more than `tolerance` (m; one for all, or (N,) one per point) beyond
+    the point's own depth. A pixel that read nothing (0) shows nothing: nothing was seen
+    there, near or far."""
     points = np.asarray(points, np.float64).reshape(-1, 3)
+    tolerance = np.broadcast_to(np.asarray(tolerance, np.float64), (len(points),))
     free = np.zeros(len(points), bool)
     for f in frames:
         uv, z, ahead = pinhole_project(points, f.K, f.T_base_cam, MIN_RANGE)
@@ -41,7 +45,7 @@ def seen_free(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float
         h, w = f.depth.shape
         i = np.flatnonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
         reading = f.depth[v[i], u[i]]
-        free[i[reading > z[i] + tolerance]] = True
+        free[i[reading > z[i] + tolerance[i]]] = True
     return free
 
 

@@ -22,7 +22,13 @@ from typing import Literal
 
 import numpy as np
 
-from laserpick.description.dims import ARM_MOUNT_POS, UR5_HIGH_READY_Q, UR5_READY_Q
+from laserpick.description.dims import (
+    ARM_MOUNT_POS,
+    UR5_HIGH_READY_Q,
+    UR5_HOME_Q,
+    UR5_READY_Q,
+    UR5_UNSTOW_Q,
+)
 from laserpick.pipeline.collision import CollisionChecker, mirrored_back
 from laserpick.pipeline.free_space import fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
@@ -40,7 +46,7 @@ VERTICAL_FLOOR_GAP = 0.003  #: m they stay above the support surface
 VERTICAL_CAP = 0.005  #: m below the top that a vertical grasp counts as the object's top face
 VERTICAL_TOP_POINTS = 30  #: points needed to place a vertical grasp by its band or top face
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
-READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready pose within this
+READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
 
 
@@ -148,6 +154,10 @@ def candidates(
     return g if isinstance(g, Failure) else [g]
 
 
+def _near(q: np.ndarray | None, pose: np.ndarray) -> bool:
+    return q is not None and bool(np.max(np.abs(q - pose)) < READY_TOLERANCE)
+
+
 def find_grasps(
     perception: Perception,
     q_ref: np.ndarray,
@@ -161,7 +171,8 @@ def find_grasps(
 
     q_ref (6,) rad: the arm's configuration when the grasp motion starts (Cj's origin and the
     IK branch preference). q_capture (6,) rad: the arm's joint angles when the frames were
-    captured; the arm's own points are then left out of the obstacles.
+    captured; the arm's own points are then left out of the obstacles, and the space they
+    filled counts as seen.
     """
     s = settings or get_settings()
     if not perception.ok or perception.segmentation is None or perception.mark is None:
@@ -179,7 +190,11 @@ def find_grasps(
     timings["detect"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     world, surroundings = CollisionChecker.world_and_surroundings(
-        cloud.points, seg.indices, margin=s.motion.clearance, q_self=q_capture
+        cloud.points,
+        seg.indices,
+        margin=s.motion.clearance,
+        q_self=q_capture,
+        frames=perception.frames,
     )
     checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
@@ -244,14 +259,16 @@ def plan_first(
 ) -> tuple[PickPlan | Failure, Grasp | None, int]:
     """Plan the grasps of `order` (default: all, best first) until one plans, as 004 does.
 
-    From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose.
+    From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose;
+    from the stowed pose, through the unstow pose first.
     The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
     it there already. Returns the plan (or the last failure), its grasp and how many grasps
     were tried.
     """
     s = settings or get_settings().motion
-    at_ready = np.max(np.abs(q_now - UR5_READY_Q)) < READY_TOLERANCE
+    at_ready = _near(q_now, UR5_READY_Q)
     via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
+    stowed = _near(q_now, UR5_HOME_Q)
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
     searches = Searches(s.rrt_max_failed)
     tried = 0
@@ -269,6 +286,7 @@ def plan_first(
             via=via,
             check_hand=found.strategy == "vertical",
             searches=searches,
+            unstow=UR5_UNSTOW_Q if stowed else None,
         )
         if not isinstance(plan, Failure):
             return plan, grasp, tried

@@ -188,11 +188,15 @@ class Searches:
         checker: CollisionChecker,
         rng: np.random.Generator,
         s: MotionSettings,
+        seen: bool = True,
     ) -> np.ndarray | None:
-        """`joint_path` from a to b with the hand checked, searched once per pick."""
+        """`joint_path` from a to b with the hand checked, searched once per pick; seen: with
+        the hand kept where the cameras saw through (`CollisionChecker.clearance_ok`), or
+        where it stands at either end."""
         key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
         if key not in self.legs:
-            self.legs[key] = joint_path(a, b, checker, rng, s, hand=True)
+            checker = checker.knowing(a, b) if seen else checker
+            self.legs[key] = joint_path(a, b, checker, rng, s, hand=True, seen=seen)
             self.failed += self.legs[key] is None
         return self.legs[key]
 
@@ -263,22 +267,28 @@ def plan_pick(
     via: Sequence[np.ndarray] = (),
     check_hand: bool = True,
     searches: Searches | None = None,
+    unstow: np.ndarray | None = None,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
-    via: configurations the transit may pass through (the ready poses, from a stowed arm):
-    the first that is clear of the cloud is used; none if none is.
+    unstow: a configuration the transit passes through first, when the cloud shows it clear
+    (from a stowed arm, `UR5_UNSTOW_Q`: the way out of the stowed pose, which stays beside
+    the scooter, where no camera sees).
+    via: configurations the transit may pass through next (the ready poses, from a stowed
+    arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
     already tested the hand's exact shape there (GPD, EL-E's sweep) may skip it.
     searches: the pick's joint-space searches so far, when several grasps are tried.
 
     world: the whole cloud; surroundings: the cloud less the target. The arm is checked
-    against the world all the way. The hand is checked against the world on the transit; on
-    the straight approach it is not, because grasp detection swept the hand in along this
-    very line (GPD pushes it in from behind, finger and palm length back); at the grasp
-    itself the hand's spheres may dip HAND_CONTACT_TOLERANCE into the surroundings (its
-    fingertips stop millimetres above the table, whose points scatter by as much). On the
-    lift only the arm is checked against the surroundings, as the hand rises from its grasp.
+    against the world all the way. The hand is checked against the world on the transit,
+    and on its last leg, to the pre-grasp, also kept to space the cameras saw through (the
+    world's frames); on the straight approach it is not, because grasp detection swept the
+    hand in along this very line (GPD pushes it in from behind, finger and palm length
+    back); at the grasp itself the hand's spheres may dip HAND_CONTACT_TOLERANCE into the
+    surroundings (its fingertips stop millimetres above the table, whose points scatter by
+    as much). On the lift only the arm is checked against the surroundings, as the hand
+    rises from its grasp.
     """
     s = settings or get_settings().motion
     searches = searches or Searches(s.rrt_max_failed)
@@ -303,10 +313,15 @@ def plan_pick(
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = None
+    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
     clear = [q for q in via if world.clearance_ok(q)[0]]
-    legs = [q_now, clear[0], q_pre] if clear else [q_now, q_pre]
-    for a, b in itertools.pairwise(legs):
-        leg = searches.path(a, b, world, rng, s)
+    legs = [q_now, *first, *clear[:1], q_pre]
+    for k, (a, b) in enumerate(itertools.pairwise(legs)):
+        # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
+        # beside the scooter and turns the elbow over above the cameras' view: a fixed way
+        # of straight moves, not held to seen space. Only the leg to the grasp is.
+        seen = k == len(legs) - 2 or not first
+        leg = searches.path(a, b, world, rng, s, seen=seen)
         if leg is None:
             transit = None
             break

@@ -44,6 +44,7 @@ import numpy as np
 from laserpick.behaviours import GRIPPER_TIME, Behaviours
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse, ray_hit
+from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
@@ -768,8 +769,23 @@ class Session:
             return
         self._stow_and_rest("Placed.")
 
+    def _surroundings(self) -> CollisionChecker:
+        """What stands around the arm now, from a fresh capture: the way home is planned
+        around it (a stow planned around an empty cloud put the hand into the 87 cm counter
+        on its way to the ready pose). The arm's own points are left out, and the space it
+        fills counts as seen."""
+        frames = self.robot.capture()
+        cloud = fuse(frames, self.settings.perception)
+        self._remember(frames, cloud)
+        return CollisionChecker(
+            cloud.points,
+            margin=self.settings.motion.clearance,
+            q_self=self.robot.joint_state().q,
+            frames=frames,
+        )
+
     def _stow_and_rest(self, message: str) -> None:
-        out = self.behaviours.stow()
+        out = self.behaviours.stow(self._surroundings())
         with self._lock:
             self.task = _Task()
             self._projection = None
@@ -801,7 +817,7 @@ class Session:
                 self.robot.sleep(GRIPPER_TIME)
             b.held = None
             self._progress("Returning the arm.")
-            b.stow()
+            b.stow(self._surroundings())
         with self._lock:
             if cancelled:
                 self._cancel.set()  # so the journal records the job as cancelled

@@ -1,0 +1,93 @@
+"""The way out of the stowed pose, and transits that keep the hand where the cameras saw.
+
+Real frames rendered by the simulated depth cameras in the isolation scene (a table before
+the scooter, nothing beside it): the space right of the scooter is beyond every camera's
+view, so a planned transit may not swing the hand through it, though no point of the cloud
+lies there."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
+from laserpick.pipeline.plan import joint_path
+from laserpick.robot.scenes import load_scene
+from laserpick.robot.sim_robot import SimRobot
+from laserpick.settings import get_settings
+
+HOME, UNSTOW, READY = dims.UR5_HOME_Q, dims.UR5_UNSTOW_Q, dims.UR5_READY_Q
+
+
+@pytest.fixture(scope="module")
+def world() -> CollisionChecker:
+    robot = SimRobot(load_scene("isolation", seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        frames = robot.capture()
+        q = robot.joint_state().q
+    finally:
+        robot.close()
+    cloud = fuse(frames)
+    return CollisionChecker(cloud.points, q_self=q, frames=frames)
+
+
+def _hand_at(x: float, y: float, z: float) -> np.ndarray:
+    """The arm with the TCP at (x, y, z) (m, `base`), gripper down as at ready."""
+    T = tcp_pose(READY)
+    T[:3, 3] = x, y, z
+    return ik_tcp(T, READY)[0]
+
+
+def test_the_way_out_of_the_stowed_pose_stays_beside_the_scooter():
+    """Home to the unstow pose, and on to either ready pose, in straight joint lines: clear
+    of the scooter, its rider and the floor; on the first, the hand never more than 0.35 m
+    out from the scooter's side (y = -0.3) or 0.3 m ahead of its front, where the move
+    straight to ready went 0.57 m out and 0.68 m ahead."""
+    free = CollisionChecker(np.zeros((0, 3)))
+    assert free.segment_ok(HOME, UNSTOW)
+    assert free.segment_ok(UNSTOW, READY) and free.segment_ok(UNSTOW, dims.UR5_HIGH_READY_Q)
+    tcp = np.array([tcp_pose(q)[:3, 3] for q in np.linspace(HOME, UNSTOW, 50)])
+    assert tcp[:, 1].min() > -0.65
+    assert tcp[:, 0].max() < 1.35
+    to_ready = np.array([tcp_pose(q)[:3, 3] for q in np.linspace(HOME, READY, 50)])
+    assert to_ready[:, 1].min() < -0.8 and to_ready[:, 0].max() > 1.65  # what it replaces
+
+
+def test_the_hand_may_not_go_where_no_camera_saw(world):
+    right = _hand_at(1.40, -0.75, 0.90)  # beside the table, right of every camera's view
+    ahead = _hand_at(1.45, 0.0, 0.90)  # above the table, in front of the cameras
+    assert world.clearance_ok(right)[0], "no point of the cloud lies there"
+    assert not world.clearance_ok(right, seen=True)[0]
+    assert world.clearance_ok(ahead, seen=True)[0]
+
+
+def test_where_the_arm_stood_and_the_way_out_count_as_seen(world):
+    """Home and the unstow pose are beyond the cameras' view, on the arm's way out; and
+    where the arm stood as the frames were taken, nothing else stood."""
+    assert world.clearance_ok(np.array([HOME, UNSTOW]), seen=True).all()
+    lo, hi = UNSTOW_BOX
+    assert lo[1] > -0.75 and hi[0] < 1.3  # beside the scooter's front, not out in the room
+    right = _hand_at(1.40, -0.75, 0.90)
+    stood = CollisionChecker(world.points, filtered=True, frames=world.frames, q_self=right)
+    assert stood.clearance_ok(right, seen=True)[0]
+    assert not stood.clearance_ok(_hand_at(1.40, -0.65, 0.80), seen=True)[0]
+
+
+def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
+    """From the ready pose to a hand beside the table's right edge: the path found keeps
+    the hand out of the blind space beside the scooter at every step between. The ends may
+    lie beyond the cameras' view: the arm stands at one and must stand at the other."""
+    rng = np.random.default_rng(0)
+    goal = _hand_at(1.50, -0.55, 0.70)
+    assert not world.clearance_ok(goal, seen=True)[0]
+    checker = world.knowing(READY, goal)
+    path = joint_path(READY, goal, checker, rng, get_settings().motion, seen=True)
+    assert path is not None
+    Q = np.vstack([np.linspace(a, b, 20) for a, b in itertools.pairwise(path)])
+    assert checker.clearance_ok(Q, seen=True).all()
