@@ -398,8 +398,9 @@ class CollisionChecker:
         """(N,) whether each sphere (centres (N, 3), `base`, m; radius (N,) m) reaches into
         space no camera saw, tested at its centre and the six points of its surface along
         `base`'s axes. A point counts as seen where a camera saw past it (by SEEN_TOLERANCE),
-        inside the arm's own spheres as the frames were captured (grown by
-        OWN_SPACE_PADDING: the arm stood there, so nothing else did), or inside UNSTOW_BOX.
+        inside the arm's own spheres as the frames were captured or as `knowing` adds them
+        (grown by OWN_SPACE_PADDING: the arm stood there, so nothing else did), or inside
+        UNSTOW_BOX.
         Points, not whole spheres, so that a sphere may straddle two of these. False for all
         without frames."""
         if not self.frames or not len(centres):

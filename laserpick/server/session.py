@@ -769,13 +769,18 @@ class Session:
             return
         self._stow_and_rest("Placed.")
 
-    def _surroundings(self) -> CollisionChecker:
+    def _surroundings(self) -> CollisionChecker | None:
         """What stands around the arm now, from a fresh capture: the way home is planned
         around it (a stow planned around an empty cloud put the hand into the 87 cm counter
         on its way to the ready pose). The arm's own points are left out, and the space it
-        fills counts as seen."""
-        frames = self.robot.capture()
-        cloud = fuse(frames, self.settings.perception)
+        fills counts as seen. None when the cameras fail: the arm must still go home, as
+        it did before it looked (rising first, `Behaviours.go_ready`)."""
+        try:
+            frames = self.robot.capture()
+            cloud = fuse(frames, self.settings.perception)
+        except Exception:
+            log.exception("No capture before stowing; stowing without one.")
+            return None
         self._remember(frames, cloud)
         return CollisionChecker(
             cloud.points,
