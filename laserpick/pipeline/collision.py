@@ -306,7 +306,9 @@ class CollisionChecker:
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.margin = margin
         self.frames = tuple(frames)
-        own = np.zeros((0, 3)) if q_self is None else sphere_centres(body_frames(q_self))[0]
+        # Where the arm stood counts as seen; only the seen-space test, with frames, asks.
+        stood = q_self is not None and bool(self.frames)
+        own = sphere_centres(body_frames(q_self))[0] if stood else np.zeros((0, 3))
         self._own = _OwnSpace(own, SPHERES.radius[: len(own)] + OWN_SPACE_PADDING)
 
     @classmethod
@@ -386,7 +388,10 @@ class CollisionChecker:
     def knowing(self, *Q: np.ndarray) -> CollisionChecker:
         """This checker, with the arm's spheres at configurations Q (6,) (rad) counted as seen
         too, as where it stood at capture: a leg's ends, where the arm stands before it and
-        must stand after (a pre-grasp beside the cameras' view, checked against the cloud)."""
+        must stand after (a pre-grasp beside the cameras' view, checked against the cloud).
+        Without frames nothing is unseen, and the checker is returned as it is."""
+        if not self.frames:
+            return self
         out = copy.copy(self)
         centres = sphere_centres(body_frames(np.array(Q, float))).reshape(-1, 3)
         reach = np.tile(SPHERES.radius + OWN_SPACE_PADDING, len(Q))

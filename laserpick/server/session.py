@@ -776,17 +776,15 @@ class Session:
         fills counts as seen. None when the cameras fail: the arm must still go home, as
         it did before it looked (rising first, `Behaviours.go_ready`)."""
         try:
-            frames = self.robot.capture()
-            cloud = fuse(frames, self.settings.perception)
+            capture = self._look()
         except Exception:
             log.exception("No capture before stowing; stowing without one.")
             return None
-        self._remember(frames, cloud)
         return CollisionChecker(
-            cloud.points,
+            capture.cloud.points,
             margin=self.settings.motion.clearance,
             q_self=self.robot.joint_state().q,
-            frames=frames,
+            frames=capture.frames,
         )
 
     def _stow_and_rest(self, message: str) -> None:
@@ -904,8 +902,15 @@ class Session:
         """The projector image now lit (height x width uint8), or None when nothing is lit."""
         return self._projection
 
-    def _remember(self, frames: Sequence[DepthFrame], cloud: FusedCloud) -> None:
-        self._capture = _Capture(tuple(frames), cloud, self.robot.base_pose(), time.monotonic())
+    def _remember(self, frames: Sequence[DepthFrame], cloud: FusedCloud) -> _Capture:
+        capture = _Capture(tuple(frames), cloud, self.robot.base_pose(), time.monotonic())
+        self._capture = capture
+        return capture
+
+    def _look(self) -> _Capture:
+        """A new capture, fused and remembered."""
+        frames = self.robot.capture()
+        return self._remember(frames, fuse(frames, self.settings.perception))
 
     def _fresh_capture(self) -> _Capture | None:
         """The last capture, if the scooter has not moved since and it is under
@@ -922,10 +927,7 @@ class Session:
         fresh = self._fresh_capture()
         if fresh is not None:
             return fresh.cloud
-        frames = self.robot.capture()
-        cloud = fuse(frames, self.settings.perception)
-        self._remember(frames, cloud)
-        return cloud
+        return self._look().cloud
 
     def status(self) -> dict[str, Any]:
         """Everything a console shows, as JSON-ready values. Cheap: read at 30 Hz."""
