@@ -26,7 +26,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.collision import CollisionChecker, carried_shape
-from laserpick.pipeline.grasping import GraspSet, plan_first
+from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose
@@ -282,7 +282,7 @@ class Behaviours:
         """Fold the arm down beside the scooter, out of the cameras' view: through ready,
         then the way out of the stowed pose backwards (`_fold_away`). checker: what stands
         around the arm, when a fresh cloud shows it (see `go_ready`)."""
-        if np.max(np.abs(self._q() - dims.UR5_HOME_Q)) < 0.05:
+        if at_pose(self._q(), dims.UR5_HOME_Q):
             return Outcome()
         out = self.go_ready(checker)
         if out.failure is not None and out.failure.kind == "ik_plan" and checker is not None:

@@ -297,6 +297,24 @@ class PerceptionSettings(BaseModel):
             " test alone also accepts a mark on a cup standing on a table. Ours."
         ),
     )
+    recall_spacing: float = Field(
+        0.15,
+        gt=0,
+        description="While the scooter drives, a view is kept each time it has gone this far"
+        " (m) since the last (`pipeline.recall`). Ours.",
+    )
+    recall_turn_deg: float = Field(
+        15.0, gt=0, description="... or turned this far (deg) since the last view. Ours."
+    )
+    recall_views: int = Field(
+        8,
+        ge=0,
+        description="Views of the drive kept: with the spacing, the last 1.2 m of the way in,"
+        " where the blind spots of the parked scooter were in view. 0 keeps none. Ours.",
+    )
+    recall_max_age: float = Field(
+        60.0, gt=0, description="A view older than this (s of robot time) is forgotten. Ours."
+    )
 
 
 class GraspSettings(BaseModel):

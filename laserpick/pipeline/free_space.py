@@ -12,7 +12,7 @@ Frames: points in `base` (m); each DepthFrame carries its pose in `base` and its
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -29,6 +29,19 @@ PROBE_DOWN = (0.15, 0.5, 0.85)
 MIN_RANGE = 0.1
 
 
+def _readings(
+    points: np.ndarray, frames: Sequence[DepthFrame]
+) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per frame: the indices of the points (N, 3) (m, `base`) in its image and ahead of it,
+    the depth read at their pixels (m, 0 for none) and their own depths (m)."""
+    for f in frames:
+        uv, z, ahead = pinhole_project(points, f.K, f.T_base_cam, MIN_RANGE)
+        u, v = np.rint(uv).astype(np.int64).T
+        h, w = f.depth.shape
+        i = np.flatnonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
+        yield i, f.depth[v[i], u[i]], z[i]
+
+
 def seen_free(
     points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float | np.ndarray
 ) -> np.ndarray:
@@ -39,14 +52,20 @@ def seen_free(
     points = np.asarray(points, np.float64).reshape(-1, 3)
     tolerance = np.broadcast_to(np.asarray(tolerance, np.float64), (len(points),))
     free = np.zeros(len(points), bool)
-    for f in frames:
-        uv, z, ahead = pinhole_project(points, f.K, f.T_base_cam, MIN_RANGE)
-        u, v = np.rint(uv).astype(np.int64).T
-        h, w = f.depth.shape
-        i = np.flatnonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
-        reading = f.depth[v[i], u[i]]
-        free[i[reading > z[i] + tolerance[i]]] = True
+    for i, reading, z in _readings(points, frames):
+        free[i[reading > z + tolerance[i]]] = True
     return free
+
+
+def hidden(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -> np.ndarray:
+    """(N,) bool: whether no camera sees each point (N, 3) (m, `base`) now: every frame
+    misses it, read nothing at its pixel, or read something nearer by more than `tolerance`
+    (m) in front of it. A point some camera reads at, or sees past, is not hidden."""
+    points = np.asarray(points, np.float64).reshape(-1, 3)
+    known = np.zeros(len(points), bool)
+    for i, reading, z in _readings(points, frames):
+        known[i[(reading > 0) & (reading >= z - tolerance)]] = True
+    return ~known
 
 
 def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:

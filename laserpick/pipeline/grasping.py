@@ -29,13 +29,14 @@ from laserpick.description.dims import (
     UR5_READY_Q,
     UR5_UNSTOW_Q,
 )
-from laserpick.pipeline.collision import CollisionChecker, mirrored_back
+from laserpick.pipeline.collision import CollisionChecker, carried_shape, mirrored_back
 from laserpick.pipeline.free_space import fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.pipeline.reach import reachable
+from laserpick.pipeline.recall import Recalled
 from laserpick.pipeline.selection import GraspClusters, group, score
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import MotionSettings, Settings, get_settings
@@ -48,6 +49,7 @@ VERTICAL_TOP_POINTS = 30  #: points needed to place a vertical grasp by its band
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
+TARGET_VOXEL = 0.01  #: m: the target's whole shape, as recalled views are checked against it
 
 
 @dataclass(frozen=True)
@@ -154,7 +156,8 @@ def candidates(
     return g if isinstance(g, Failure) else [g]
 
 
-def _near(q: np.ndarray | None, pose: np.ndarray) -> bool:
+def at_pose(q: np.ndarray | None, pose: np.ndarray) -> bool:
+    """Whether joint angles q (6,) (rad) are at `pose` (6,), within READY_TOLERANCE."""
     return q is not None and bool(np.max(np.abs(q - pose)) < READY_TOLERANCE)
 
 
@@ -166,13 +169,16 @@ def find_grasps(
     strategy: Strategy = "gpd",
     settings: Settings | None = None,
     rng: np.random.Generator | None = None,
+    recalled: Recalled | None = None,
 ) -> GraspSet | Failure:
     """Detect, filter, score and cluster grasps on the target of a successful perception.
 
     q_ref (6,) rad: the arm's configuration when the grasp motion starts (Cj's origin and the
     IK branch preference). q_capture (6,) rad: the arm's joint angles when the frames were
     captured; the arm's own points are then left out of the obstacles, and the space they
-    filled counts as seen.
+    filled counts as seen. recalled: the views kept on the way in (`recall.ViewMemory`):
+    the planner counts what they saw through as seen too, and what they saw where no camera
+    sees now as obstacles.
     """
     s = settings or get_settings()
     if not perception.ok or perception.segmentation is None or perception.mark is None:
@@ -189,12 +195,18 @@ def find_grasps(
     found = candidates(perception, strategy, s, rng)
     timings["detect"] = time.perf_counter() - t0
     t0 = time.perf_counter()
+    recalled = recalled or Recalled()
+    # The views saw the target from elsewhere: what they saw of it that is hidden now is
+    # the target, not an obstacle beside it. Its extent is the carry's model of it.
+    support = seg.surface.height if seg.surface is not None else None
+    whole = carried_shape(target, support, voxel=TARGET_VOXEL)
+    blind = recalled.blind_points(perception.frames, whole, support)
     world, surroundings = CollisionChecker.world_and_surroundings(
-        cloud.points,
+        np.vstack([cloud.points, blind]) if len(blind) else cloud.points,
         seg.indices,
         margin=s.motion.clearance,
         q_self=q_capture,
-        frames=perception.frames,
+        frames=(*perception.frames, *recalled.frames),
     )
     checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
     timings["filter"] = time.perf_counter() - t0
@@ -246,7 +258,6 @@ def find_grasps(
     scored = [score(g, q_now=q_ref, sample=target, mark=mark, settings=s.grasp) for g in ok]
     clusters = group(scored, s.grasp)
     timings["select"] = time.perf_counter() - t0
-    support = seg.surface.height if seg.surface is not None else None
     return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings, support)
 
 
@@ -266,9 +277,9 @@ def plan_first(
     were tried.
     """
     s = settings or get_settings().motion
-    at_ready = _near(q_now, UR5_READY_Q)
+    at_ready = at_pose(q_now, UR5_READY_Q)
     via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
-    stowed = _near(q_now, UR5_HOME_Q)
+    stowed = at_pose(q_now, UR5_HOME_Q)
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
     searches = Searches(s.rrt_max_failed)
     tried = 0

@@ -31,6 +31,7 @@ Frames: points in `base` (m) unless a method says `world`; angles in radians.
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -45,10 +46,11 @@ from laserpick.behaviours import GRIPPER_TIME, Behaviours
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse, ray_hit
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
+from laserpick.pipeline.recall import Recalled, ViewMemory
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
 from laserpick.robot.scenes import Scene
@@ -190,6 +192,10 @@ class Session:
         self._scene_listeners: list[Callable[[SimRobot], None]] = []
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="laserpick-session")
         self._job: Future[None] | None = None
+        #: Views kept while driving are taken here in real time, so a drive command never
+        #: waits on a capture.
+        self._view_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="laserpick-views")
+        self._view_job: Future[None] | None = None
         self._job_name = ""
         self._cancel = threading.Event()
         self._cancel_reason = "Cancelled by the operator."  #: why `_cancel` was set
@@ -224,6 +230,14 @@ class Session:
         self.message = "Ready. Aim the laser at an object."
         self._projection: np.ndarray | None = None
         self._capture: _Capture | None = None
+        p = self.settings.perception
+        self.views = ViewMemory(
+            p.recall_spacing,
+            math.radians(p.recall_turn_deg),
+            p.recall_views,
+            p.recall_max_age,
+            p,
+        )
 
     def close(self) -> None:
         """Halt, stop the worker and the watchdog, and close the robot."""
@@ -231,6 +245,7 @@ class Session:
         self._cancel.set()
         self.robot.halt()
         self._worker.shutdown(wait=True, cancel_futures=True)
+        self._view_pool.shutdown(wait=True, cancel_futures=True)
         self._watchdog.join(timeout=1.0)
         self.robot.close()
 
@@ -564,6 +579,37 @@ class Session:
                 aiming = self.robot.laser.state.on
                 self._set(TaskState.AIMING if aiming else TaskState.IDLE, "Driving.")
             self._capture = None
+        self._keep_view()
+
+    def _keep_view(self) -> None:
+        """On the way, keep a view each `recall_spacing` m or `recall_turn_deg` (the
+        `ViewMemory`): where the scooter stops, its fixed cameras have blind spots that were
+        in view on the way in. In real time the capture runs on its own thread, so the drive
+        command does not wait on it; headless, it runs at once, so a run replays exactly."""
+        robot = self.robot
+        # Only with the arm stowed and the hand empty, as they are when a grasp is planned:
+        # a view never shows the arm elsewhere, nor an object riding along in the hand.
+        stowed = at_pose(robot.joint_state().q, dims.UR5_HOME_Q)
+        if not stowed or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
+            return
+        if not robot.sim.realtime:
+            self._take_view(robot)
+        elif self._view_job is None or self._view_job.done():
+            self._view_job = self._view_pool.submit(self._take_view, robot)
+
+    def _take_view(self, robot: SimRobot) -> None:
+        pose = robot.base_pose()
+        try:
+            frames = robot.capture()
+        except Exception:  # a view is extra evidence; a drive goes on without it
+            log.exception("A view on the way could not be captured.")
+            return
+        if robot is self.robot:  # not a view of a scene replaced meanwhile
+            self.views.add(frames, pose)
+
+    def _recalled(self) -> Recalled:
+        """The views kept on the way in, in `base` as the scooter stands now."""
+        return self.views.recall(self.robot.base_pose(), self.robot.joint_state().stamp)
 
     def _await_estop(self, latched: bool, timeout: float = 0.5) -> None:
         """Wait (briefly) until the simulation has applied an e-stop or its reset, so that the
@@ -700,6 +746,7 @@ class Session:
             strategy="vertical" if strategy == "jeeves" else strategy,
             settings=self.settings,
             rng=self._rng,
+            recalled=self._recalled(),
         )
         with self._lock:
             self.task.perception = perception
@@ -773,18 +820,21 @@ class Session:
         """What stands around the arm now, from a fresh capture: the way home is planned
         around it (a stow planned around an empty cloud put the hand into the 87 cm counter
         on its way to the ready pose). The arm's own points are left out, and the space it
-        fills counts as seen. None when the cameras fail: the arm must still go home, as
+        fills counts as seen; the views kept on the way in add what they saw where no camera
+        sees now. None when the cameras fail: the arm must still go home, as
         it did before it looked (rising first, `Behaviours.go_ready`)."""
         try:
             capture = self._look()
         except Exception:
             log.exception("No capture before stowing; stowing without one.")
             return None
+        recalled = self._recalled()
+        blind = recalled.blind_points(capture.frames)
         return CollisionChecker(
-            capture.cloud.points,
+            np.vstack([capture.cloud.points, blind]) if len(blind) else capture.cloud.points,
             margin=self.settings.motion.clearance,
             q_self=self.robot.joint_state().q,
-            frames=capture.frames,
+            frames=(*capture.frames, *recalled.frames),
         )
 
     def _stow_and_rest(self, message: str) -> None:
