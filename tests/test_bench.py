@@ -36,6 +36,7 @@ from laserpick.bench.protocols import (
     UPRIGHT_TILT,
     Options,
     _operated,
+    _still_there,
     coin_flip_kitchen,
     jeeves_scene,
     placed_tilt,
@@ -343,3 +344,28 @@ def test_a_can_that_rolls_on_its_side_is_not_tipped_but_one_stood_up_is():
     raised = quat_from_matrix(rotx(math.pi / 2 - math.radians(20)))  # axis 20 deg up
     assert placed_tilt(can, before, raised) == pytest.approx(math.radians(20))
     assert placed_tilt(can, before, quat_from_matrix(np.eye(3))) == pytest.approx(math.pi / 2)
+
+
+def test_a_pick_place_task_is_tried_again_while_its_object_stands_where_it_stood(
+    tmp_path: Path,
+) -> None:
+    """004 section 8.3's user tried a task again when an attempt failed: a clear cup, which
+    the depth cameras do not see, is marked three times (each try re-marks twice more), all
+    three tries one task; a task whose object has left its spot is not tried again."""
+    scene = tmp_path / "cup.yaml"
+    scene.write_text(
+        "name: cup\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: t, kind: table, xy: [1.6, -0.2], size: [0.6, 1.0], height: 0.46}\n"
+        "  - {name: t2, kind: table, xy: [1.6, 1.8], size: [0.6, 1.0], height: 0.46}\n"
+        "objects:\n  - {name: cup, model: glass_cup, on: t, xy: [1.45, -0.3]}\n"
+    )
+    opt = Options(selection="manual", scene=str(scene))
+    records = PROTOCOLS["pick-place"].run(0, 1, opt)
+    assert [r.task for r in records] == [0, 0, 0]
+    assert all(r.failure == "precondition" and r.marks == 3 for r in records)
+    assert summarize([r.as_dict() for r in records])["tasks"] == 1
+    with _operated(load_scene(str(scene)), 0, 1, opt) as op:
+        stood = op.referee.world_position("cup")
+        assert _still_there(op, "cup", stood)
+        op.referee.take_out("cup")
+        assert not _still_there(op, "cup", stood)

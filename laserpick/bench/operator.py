@@ -250,22 +250,24 @@ def parking_pose(
     level: float | None = None,
     local_x: float | None = None,
     turn: float = 0.0,
+    back: float = 0.0,
 ) -> np.ndarray:
     """Where the user parks to work on `surface` at height `level` (m; default its lowest
     level): facing it, its front edge PARK_EDGE ahead of the rear axle (PARK_EDGE_HIGH when
     the level is above the arm's shoulder) and the spot `local_y` (m, the surface's frame)
     in front of the arm. On a floor, with the spot's `local_x` (m) given, the spot itself
     PARK_FLOOR_REACH ahead instead, the scooter facing the floor's +x turned by `turn`
-    (rad): a floor may be driven onto from any side. Returns (x, y, yaw) in `world` (m,
-    rad)."""
+    (rad): a floor may be driven onto from any side. `back` (m): that much farther back.
+    Returns (x, y, yaw) in `world` (m, rad)."""
     level = surface.levels[0] if level is None else level
     edge = PARK_EDGE_HIGH if level > dims.ARM_MOUNT_POS[2] + dims.UR5_D[0] else PARK_EDGE
     c, s = math.cos(surface.yaw), math.sin(surface.yaw)
-    ahead = edge + PARK_SPOT_DEPTH
+    ahead = edge + PARK_SPOT_DEPTH + back
     spot_local = np.array([-surface.size[0] / 2 + PARK_SPOT_DEPTH, local_y])
     yaw = surface.yaw  # the front faces the surface's local -x: face its +x
     if surface.kind == "floor" and local_x is not None:
-        ahead, spot_local, yaw = PARK_FLOOR_REACH, np.array([local_x, local_y]), yaw + turn
+        ahead, spot_local = PARK_FLOOR_REACH + back, np.array([local_x, local_y])
+        yaw += turn
     spot = np.asarray(surface.xy) + np.array(
         [c * spot_local[0] - s * spot_local[1], s * spot_local[0] + c * spot_local[1]]
     )

@@ -25,7 +25,14 @@ from laserpick.description import dims
 from laserpick.pipeline.types import Failure
 from laserpick.robot.scenes import Scene
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.server.session import Actor, Selection, Session, StrategyName, TaskState
+from laserpick.server.session import (
+    HOLDING_STATES,
+    Actor,
+    Selection,
+    Session,
+    StrategyName,
+    TaskState,
+)
 from laserpick.settings import Settings, get_settings
 
 BENCH = Actor("bench")
@@ -55,6 +62,7 @@ class Attempt:
     strategy: str
     task: int = 0  #: which task of the trial: the tries at one object share it
     marks: int = 0  #: marks made (re-marks after a missed dot count)
+    places: int = 0  #: place marks confirmed (pick and place)
     detected: bool = False  #: the grasp chosen (or executed) was on the marked object
     #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)
     grasped: bool = False
@@ -271,7 +279,7 @@ class ScriptedOperator:
     def place(self, spot: np.ndarray) -> Placed:
         """Mark `spot` (m, `base`) as where the held object goes, and let the session place it."""
         s = self.session
-        if s.state != TaskState.AWAITING_PLACE:
+        if s.state not in HOLDING_STATES:  # holding after a failed place: aiming marks again
             failure = Failure("precondition", f"nothing to place (the session is {s.state.value})")
             return Placed(failure, None)
         self.aim(spot)

@@ -11,7 +11,9 @@ in any order, and give the same attempts for the same seed.
   each object's surface and tries until the object is in the basket (at most MAX_TRIES).
 - pick-place (004 section 8.3): every `kitchen` object, upright or on its side by coin flip;
   the user drives to it, the robot picks it (manual selection), the user drives to another
-  surface and marks a free spot, and the robot sets it down there.
+  surface and marks a free spot, and the robot sets it down there. As in in-situ, the user
+  tries again (at most MAX_TRIES picks, and as many place marks) while that can still
+  finish the task.
 - selection (004 section 8.4): two objects side by side; one attempt with automatic and one
   with manual selection, each from the same start.
 - surfaces (000 section 5.1): the phone and the pill on each of the twelve surfaces of the
@@ -62,11 +64,23 @@ from laserpick.robot.scenes import (
     parse_scene,
     scene_config,
 )
-from laserpick.server.session import Selection, StrategyName, TaskState
+from laserpick.server.session import HOLDING_STATES, Selection, StrategyName, TaskState
 from laserpick.transforms import matrix_from_quat, planar_pose
 
-#: Tries per object in the in-situ protocol (004 section 8.2 retried until retrieved).
+#: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until
+#: retrieved; in section 8.3 a task could take more than one pick-and-place attempt, 150
+#: grasp and 104 place attempts for 84 tasks in Table 5), and place marks per pick.
 MAX_TRIES = 3
+#: An object still within this (m) of where it stood, across and in height, can be tried
+#: again: a failed attempt left it in place, or only nudged it.
+STILL_THERE = (0.05, 0.02)
+#: m the user parks farther back for each try after the arm could not take the object (an
+#: ik_plan failure), as a person told that the arm cannot reach moves the scooter: under a
+#: shelf's board the arm needs room to come in level.
+RETRY_BACK = 0.10
+#: What an attempt says when the user found no way to park in front of its object: trying
+#: again would drive the same way.
+NO_PARKING = "the user could not park in front of it"
 #: Headings (rad, from the floor's +x) the user tries, in order, to park at an object on a
 #: floor: the other objects lying there may block a side.
 FLOOR_TURNS = tuple(math.radians(a) for a in (0, 45, -45, 90, -90, 135, -135, 180))
@@ -303,15 +317,15 @@ def _around(op: ScriptedOperator, scene: Scene) -> list[Surface | Footprint]:
     return obstacles(scene.surfaces, op.referee, op.referee.instances())
 
 
-def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str) -> bool:
+def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str, back: float = 0.0) -> bool:
     """Drive from wherever the scooter is to park in front of the object's surface, the
-    object before the arm (on the floor: before the object itself). Returns whether it
-    parked."""
+    object before the arm (on the floor: before the object itself), `back` m farther back
+    than at first. Returns whether it parked."""
     placement = scene.placement(instance)
     surface = scene.surface(placement.surface)
     level = surface.levels[placement.level]
     local_x, local_y = surface.to_local(op.referee.world_position(instance)[:2])
-    return _park(op, scene, surface, float(local_x), float(local_y), level)
+    return _park(op, scene, surface, float(local_x), float(local_y), level, back=back)
 
 
 def _park(
@@ -322,15 +336,17 @@ def _park(
     local_y: float,
     level: float,
     outline: Outline | None = None,
+    back: float = 0.0,
 ) -> bool:
-    """Drive to work at the spot (local x, y: m in the surface's frame; level: its height)
-    and say whether the user parked there. A floor may be driven onto from any side: the
-    user tries each of FLOOR_TURNS in turn until one leads there."""
+    """Drive to work at the spot (local x, y: m in the surface's frame; level: its height),
+    `back` m farther back than at first, and say whether the user parked there. A floor may
+    be driven onto from any side: the user tries each of FLOOR_TURNS in turn until one
+    leads there."""
     turns = FLOOR_TURNS if surface.kind == "floor" else (0.0,)
     outline = outline or op.referee.outline()
     around = _around(op, scene)
     for turn in turns:
-        goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn)
+        goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn, back=back)
         if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
             return True
         last = turn == turns[-1]
@@ -348,23 +364,31 @@ def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
     with _operated(scene, trial, seed, opt) as op:
         names = _shuffled(op, _instances(scene))[:IN_SITU_OBJECTS]
         for task, name in enumerate(_limit(names, opt)):
+            back = 0.0
             parked = _go_to_object(op, scene, name)
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 rec.task = task
                 if not parked:
-                    rec.fail("precondition", "the user could not park in front of it")
+                    rec.fail("precondition", NO_PARKING)
                     out.append(rec)
                     break
+                stood = op.referee.world_position(name)
                 out.append(op.pick_and_drop(rec))
-                if rec.success or _gone(op, name):
+                if rec.success or not _still_there(op, name, stood):
                     break
+                if rec.failure == "ik_plan":
+                    back += RETRY_BACK
+                    parked = _go_to_object(op, scene, name, back)
     return out
 
 
-def _gone(op: ScriptedOperator, name: str) -> bool:
-    """Whether the object has left its surface (fallen to the floor, or taken out)."""
-    return bool(op.referee.world_position(name)[2] < 0.02)
+def _still_there(op: ScriptedOperator, name: str, stood: np.ndarray) -> bool:
+    """Whether the object is still where it stood (m, `world`), within STILL_THERE: not
+    fallen, carried off or taken out, so the user can try it again."""
+    now = op.referee.world_position(name)
+    across, height = STILL_THERE
+    return bool(np.linalg.norm(now[:2] - stood[:2]) < across and abs(now[2] - stood[2]) < height)
 
 
 def coin_flip_kitchen(rng: np.random.Generator) -> Scene:
@@ -412,10 +436,17 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     scene = _scene("", seed, opt) if opt.scene else coin_flip_kitchen(rng)
     out = []
     with _operated(scene, trial, seed, opt) as op:
-        for name in _limit(_shuffled(op, _instances(scene)), opt):
-            rec = op.new_attempt(name, opt.selection, opt.strategy)
-            out.append(_move_object(op, scene, rec))
-            op.tidy()
+        for task, name in enumerate(_limit(_shuffled(op, _instances(scene)), opt)):
+            back = 0.0
+            for _ in range(MAX_TRIES):
+                rec = op.new_attempt(name, opt.selection, opt.strategy)
+                rec.task = task
+                stood = op.referee.world_position(name)
+                out.append(_move_object(op, scene, rec, back))
+                op.tidy()
+                if rec.success or rec.message == NO_PARKING or not _still_there(op, name, stood):
+                    break
+                back += RETRY_BACK if rec.failure == "ik_plan" else 0.0
     return out
 
 
@@ -452,11 +483,12 @@ def placed_tilt(model: ObjectModel, before: np.ndarray, after: np.ndarray) -> fl
     return math.acos(float(np.clip(up_before @ up_after, -1.0, 1.0)))
 
 
-def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
-    """One 004 section 8.3 task: pick `rec.instance` and set it down on another surface."""
+def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float = 0.0) -> Attempt:
+    """One 004 section 8.3 attempt: pick `rec.instance`, parked `back` m farther back than at
+    first, and set it down on another surface."""
     session, referee = op.session, op.referee
-    if not _go_to_object(op, scene, rec.instance):
-        return rec.fail("precondition", "the user could not park in front of it")
+    if not _go_to_object(op, scene, rec.instance, back):
+        return rec.fail("precondition", NO_PARKING)
     session.set_mode(op.actor, mode="pick_and_place")
     quat_before = referee.world_quat(rec.instance)
     if not op.pick(rec) or rec.failure is not None:
@@ -474,18 +506,29 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt) -> Attempt:
     # The user marks the spot from the seat: a top above their hand (the 100 cm shelf top,
     # the 108 cm table) shows them only its front edge.
     markable = [s for s in scene.surfaces if s.levels[-1] < dims.LASER_ORIGIN[2] - 0.05]
-    dests = [s for s in markable if s.name != here]
-    dest = dests[int(op.rng.integers(len(dests)))] if dests else scene.surface(here)
-    spot = free_spot(op, dest)
-    if spot is None:
-        return rec.fail("precondition", f"no free spot on {dest.name}")
-    local_y, spot_world = spot
-    local_x = float(dest.to_local(spot_world[:2])[0])
-    outline = op.referee.outline()  # the object in hand included
-    if not _park(op, scene, dest, local_x, local_y, spot_world[2], outline):
-        return rec.fail("precondition", f"the user could not park at {dest.name}")
+    dests = [s for s in markable if s.name != here] or [scene.surface(here)]
+    # A random other surface; where it has no free spot, or no way to park at one, the user
+    # takes the next, as a person with something in hand would.
+    failure = Failure("precondition", "no surface to put it on")
+    for dest in (dests[int(k)] for k in op.rng.permutation(len(dests))):
+        spot = free_spot(op, dest)
+        if spot is None:
+            failure = Failure("precondition", f"no free spot on {dest.name}")
+            continue
+        local_y, spot_world = spot
+        local_x = float(dest.to_local(spot_world[:2])[0])
+        outline = op.referee.outline()  # the object in hand included
+        if _park(op, scene, dest, local_x, local_y, spot_world[2], outline):
+            break
+        failure = Failure("precondition", f"the user could not park at {dest.name}")
+    else:
+        return rec.fail(failure.kind, failure.message)
     spot_base = referee.to_base(spot_world)
-    placed = op.place(spot_base)
+    for _ in range(MAX_TRIES):  # the user marks again while the hand still holds it
+        placed = op.place(spot_base)
+        rec.places += 1
+        if placed.failure is None or session.state not in HOLDING_STATES:
+            break
     if placed.failure is not None or placed.hit is None:
         failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
         return rec.fail(failure.kind, failure.message)
