@@ -4,20 +4,22 @@ A real `laserpick serve` on `isolation`, and its page at `/` in headless Chromiu
 in the page's frame at the detail the page chooses (`--detail`; "auto" is half on this
 machine, which draws WebGL without a GPU). For each object: click on it in the 3D view
 (aim), click again on the same spot (confirm), and time from the confirming click's
-pointerdown in the browser to the 3D view sending the lit cloud to the browser (its
-`highlight` event on the events stream). Both clocks are this machine's wall clock. Not
-counted: the loopback hop back to the browser and the frame that draws it; the script
-prints the browser's frame interval beside the figure for that. Between trials the mark is
-cancelled. `--pause S` waits S seconds between the aiming click taking effect and the
-confirming click, as a person does who looks at the dot before confirming it; at 0 (the
-default) the confirming click lands while the browser is still drawing the aim.
+pointerdown in the browser to the frame that draws the highlight: the first WebGL draw of
+as many points as the lit cloud the 3D view sent (its `highlight` event on the events
+stream says how many). A hook on `drawArrays` in the view's frame stamps every point draw.
+Also printed: the time to the lit cloud sent (or, when the highlight was sent ahead of the
+confirm, hidden, to the message that shows it). Both clocks are this machine's wall clock.
+Between trials the mark is cancelled. `--pause S` waits S seconds between the aiming click
+taking effect and the confirming click, as a person does who looks at the dot before
+confirming it; at 0 (the default) the confirming click lands while the browser is still
+drawing the aim.
 
     MUJOCO_GL=egl .venv/bin/python bench/click_latency.py [--rounds 2] [--pause S]
         [--detail auto|full|half] [--no-browser]
 
 `--no-browser` measures the server alone, in this process: the session, the 3D view's drawing
 and its viser server without a browser, from a click-confirmed mark (`Session.confirm` with
-the object's centre as the point) to the lit cloud sent.
+the object's centre as the point, aimed there as a click aims) to the lit cloud sent.
 
 It prints each trial and the median, p90 and max. The browser renders WebGL in software
 (SwiftShader), so a frame takes longer here than on a machine with a GPU.
@@ -45,10 +47,19 @@ from laserpick.client import Client  # noqa: E402
 from laserpick.console import headless_chromium  # noqa: E402
 from laserpick.console.viewer import default_view_pixel  # noqa: E402
 
-# The wall-clock time (ms since the epoch) of every pointerdown, and a running measure of the
-# interval between animation frames.
+# The wall-clock time (ms since the epoch) of every pointerdown, a running measure of the
+# interval between animation frames, and the time and size of every WebGL draw of points.
 PROBE = """
-window.__lp = { downs: [], frames: [] };
+window.__lp = { downs: [], frames: [], draws: [] };
+for (const C of [window.WebGLRenderingContext, window.WebGL2RenderingContext]) {
+  if (!C) continue;
+  const draw = C.prototype.drawArrays;
+  C.prototype.drawArrays = function (mode, first, count) {
+    if (mode === 0 && window.__lp.draws.length < 50000)  // gl.POINTS
+      window.__lp.draws.push([performance.timeOrigin + performance.now(), count]);
+    return draw.call(this, mode, first, count);
+  };
+}
 document.addEventListener(
   "pointerdown", (e) => window.__lp.downs.push(performance.timeOrigin + e.timeStamp), true);
 let last = null;
@@ -103,7 +114,8 @@ def main() -> int:
     args = parser.parse_args()
     if args.no_browser:
         return server_only(args.rounds)
-    samples: list[float] = []
+    drawn: list[float] = []  #: click to the frame that draws the highlight (ms)
+    sent: list[float] = []  #: click to the lit cloud (or the message showing it) sent (ms)
     server_share: list[float] = []  #: from the click's arrival in the server (ms)
     with tempfile.TemporaryDirectory() as tmp:
         server = ServeProcess(Path(tmp), extra_args=("--lite-view",)).start()
@@ -137,33 +149,39 @@ def main() -> int:
                             for e in api.events[seen:]
                             if e["name"] == "highlight" and e["t"] > clicked
                         ]
-                        if shown:
-                            samples.append(1000.0 * (shown[0]["t"] - clicked))
-                            share = 1000.0 * (shown[0].get("since_click") or float("nan"))
-                            server_share.append(share)
-                            print(
-                                f"{obj['name']:>18}: {samples[-1]:6.0f} ms, of which the server"
-                                f" {share:4.0f} ms  ({state['state']})"
-                            )
-                        else:
+                        if not shown:
                             print(f"{obj['name']:>18}: no highlight ({state['message']})")
+                            api.post("/cancel")
+                            continue
+                        lit = shown[0]
+                        draws = frame.evaluate("window.__lp.draws")
+                        first = [t for t, n in draws if n == lit["points"] and t > clicked * 1e3]
+                        sent.append(1000.0 * (lit["t"] - clicked))
+                        share = 1000.0 * (lit.get("since_click") or float("nan"))
+                        server_share.append(share)
+                        drew = f"{first[0] - clicked * 1e3:6.0f} ms" if first else "   not seen"
+                        if first:
+                            drawn.append(first[0] - clicked * 1e3)
+                        print(
+                            f"{obj['name']:>18}: drawn {drew}; sent {sent[-1]:4.0f} ms, of which"
+                            f" the server {share:4.0f} ms  ({state['state']})"
+                        )
                         api.post("/cancel")
                 frames = frame.evaluate("window.__lp.frames")
                 browser.close()
         finally:
             api.release()
             server.close()
-    if not samples:
-        print("no highlight was seen")
+    if not drawn:
+        print("no highlight was seen drawn")
         return 1
-    ordered = np.sort(samples)
     print(
-        f"\nclick-to-highlight over {len(samples)} marks: median {statistics.median(samples):.0f}"
-        f" ms, p90 {np.percentile(ordered, 90):.0f} ms, max {ordered[-1]:.0f} ms (target 250);"
-        f" the server's share (click arrived to lit cloud sent): median"
-        f" {statistics.median(server_share):.0f} ms;"
-        f" the browser's frame interval: median {statistics.median(frames):.0f} ms"
-        " (software WebGL)"
+        f"\nclick-to-highlight over {len(drawn)} of {len(sent)} marks, to the frame that draws"
+        f" it: median {statistics.median(drawn):.0f} ms, p90 {np.percentile(drawn, 90):.0f} ms,"
+        f" max {max(drawn):.0f} ms (target 250). To it sent: median"
+        f" {statistics.median(sent):.0f} ms; the server's share (click arrived to sent): median"
+        f" {statistics.median(server_share):.0f} ms; the browser's frame interval: median"
+        f" {statistics.median(frames):.0f} ms (software WebGL)"
     )
     return 0
 
@@ -195,8 +213,8 @@ def server_only(rounds: int) -> int:
             for name in referee.instances():
                 pts = referee.object_points(name)
                 centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
-                session.aim_at(actor, centre, "base")
                 session.cloud()  # the capture a first click makes while aiming
+                session.aim_at(actor, centre, "base", foresee=True)  # as a click aims
                 time.sleep(0.5)
                 shown.clear()
                 t0 = time.monotonic()

@@ -37,3 +37,68 @@ def test_a_click_confirmed_mark_is_perceived_in_the_cloud_it_was_aimed_in() -> N
         assert np.linalg.norm(perception.mark.point - centre) < 1e-9
     finally:
         session.close()
+
+
+def _wait(predicate, timeout: float = 30.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.02)
+
+
+def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> None:
+    """A click aims and the session works the mark out at once; the 3D view sends its
+    highlight ahead, hidden. The confirm at that point takes that very perception and
+    shows that very node. A confirm elsewhere, or after the scooter moved, works the mark
+    out anew."""
+    import viser
+
+    from laserpick.console.operator_console import OperatorConsole
+
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    console = OperatorConsole(session, server)
+    console.start()
+    try:
+        actor = Actor("console", session.lease.acquire("test", "console"))
+        referee = Referee(session.robot)
+        names = referee.instances()
+        centre = [
+            (p.min(axis=0) + p.max(axis=0)) / 2 for p in map(referee.object_points, names[:2])
+        ]
+        session.cloud()  # the capture a click makes
+        session.aim_at(actor, centre[0], "base", foresee=True)
+        _wait(lambda: session.foreseen is not None)
+        cloud, image = session.foreseen
+        assert cloud is session.latest_cloud[0] and image.any()
+        _wait(lambda: any(k.startswith("lit-") for k in console._drawn.nodes))
+        (ahead,) = [h for k, h in console._drawn.nodes.items() if k.startswith("lit-")]
+        assert not ahead.visible
+        foreseen = session._foreseen
+        session.confirm(actor, point=centre[0])
+        _wait(lambda: not session.busy and session.state != TaskState.MARKED)
+        assert session.task.perception is foreseen.perception
+        assert session.projection is image
+        _wait(lambda: console._drawn.nodes.get("lit") is ahead)
+        assert ahead.visible
+        # Aimed there again in the same capture: nothing new to work out. Confirmed
+        # elsewhere: worked out anew, in the same capture.
+        session.cancel(actor)
+        _wait(lambda: not session.busy)
+        session.aim_at(actor, centre[0], "base", foresee=True)
+        _wait(lambda: session.foreseen is not None)
+        assert session._foreseen is foreseen
+        session.confirm(actor, point=centre[1])
+        _wait(lambda: not session.busy and session.state != TaskState.MARKED)
+        assert session.task.perception is not foreseen.perception
+        assert session.task.perception.cloud is foreseen.perception.cloud
+        assert np.allclose(session.task.perception.mark.point, centre[1])
+        # Driven: the capture, and what was worked out in it, are stale.
+        session.cancel(actor)
+        _wait(lambda: not session.busy)
+        session.drive(actor, 0.1, 0.0, 0.2)
+        assert session.foreseen is None
+    finally:
+        console.stop()
+        session.close()
+        server.stop()

@@ -104,6 +104,10 @@ class _Drawn:
 
     cloud_key: tuple[int, int] | None = None
     lit_key: tuple[int, int] | None = None
+    #: The foreseen highlight sent ahead, hidden ("lit-ahead"), and its number of points.
+    ahead_key: tuple[int, int] | None = None
+    ahead_points: int = 0
+    sent_ahead: int = 0
     grasp_key: tuple[int, int, int] | None = None
     place_key: tuple[float, ...] | None = None
     laser_key: tuple[float, ...] | None = None
@@ -202,21 +206,22 @@ class OperatorConsole:
 
     def _clicked(self, event: viser.SceneClickEvent) -> None:
         """Aim where the click's ray meets the cloud; a second click near the aimed point
-        confirms the mark (or the place mark)."""
+        confirms the mark there (or the place mark), as the laser points: the session has
+        worked that mark out since the first click."""
         session = self.session
         origin = np.asarray(event.ray_origin, dtype=float)
         direction = np.asarray(event.ray_direction, dtype=float)
         before = self._aimed_at if session.state in CONFIRMABLE else None
         hit: list[np.ndarray] = []
         if not self.act(
-            event.client, lambda a: hit.append(session.aim_ray(a, origin, direction, "world"))
+            event.client, lambda a: hit.append(session.ray_point(origin, direction, "world"))
         ):
             return
         if before is not None and np.linalg.norm(hit[0] - before) < CONFIRM_RADIUS:
             self._aimed_at = None
             self._confirmed_at = time.monotonic()
-            self.act(event.client, lambda a: session.confirm(a, point=hit[0]))
-        else:
+            self.act(event.client, lambda a: session.confirm(a, point=before))
+        elif self.act(event.client, lambda a: session.aim_at(a, hit[0], "base", foresee=True)):
             self._aimed_at = hit[0]
 
     # --- the panel -------------------------------------------------------------------------
@@ -298,7 +303,8 @@ class OperatorConsole:
     # --- drawing ---------------------------------------------------------------------------
 
     def _on_event(self, event: dict) -> None:
-        if event.get("name") in ("state", "grasp", "scene", "failure", "estop", "job"):
+        names = ("state", "grasp", "scene", "failure", "estop", "job", "foreseen")
+        if event.get("name") in names:
             self._wake.set()
 
     def _loop(self) -> None:
@@ -329,16 +335,18 @@ class OperatorConsole:
 
     def _node(self, key: str, handle: viser.SceneNodeHandle | None) -> None:
         # Adding a node under a name in use replaces the old one, so only a node that is not
-        # replaced needs removing.
+        # replaced by one of its name needs removing.
         old = self._drawn.nodes.pop(key, None)
         if handle is not None:
             self._drawn.nodes[key] = handle
-        elif old is not None:
+        if old is not None and (handle is None or old.name != handle.name):
             old.remove()
 
     def _draw_cloud(self) -> None:
         """The lit points first (the highlight is what the user waits for), then the dark
-        cloud under them, each only when it changed."""
+        cloud under them, each only when it changed. A highlight the session foresaw (a
+        clicked mark worked out before its confirm) is sent ahead, hidden: the confirm then
+        shows it, a few bytes instead of its points."""
         latest = self.session.latest_cloud
         image = self.session.projection
         lit_key = None if latest is None else (id(latest[0]), id(image))
@@ -346,7 +354,8 @@ class OperatorConsole:
         if latest is None:
             self._node("cloud", None)
             self._node("lit", None)
-            self._drawn.cloud_key = self._drawn.lit_key = None
+            self._node("lit-ahead", None)
+            self._drawn.cloud_key = self._drawn.lit_key = self._drawn.ahead_key = None
             return
         cloud, pose = latest
         if self._drawn.pixels_of is not cloud:
@@ -356,35 +365,38 @@ class OperatorConsole:
             self._drawn.pixels_of = cloud
         if lit_key != self._drawn.lit_key:
             self._drawn.lit_key = lit_key
-            assert self._drawn.pixels is not None
-            lit = (
-                cloud.points[lit_by(image, self._drawn.pixels)]
-                if image is not None
-                else cloud.points[:0]
-            )
-            # Larger and bright, and drawn whether or not the cloud is: the projector's light
-            # on the object shows either way.
-            self._node(
-                "lit",
-                self.server.scene.add_point_cloud(
-                    f"{_ROOT}/lit",
-                    points=to_world(lit[voxel_first(lit, LIT_VOXEL)], pose).astype(np.float32),
-                    colors=LIT,
-                    point_size=LIT_POINT_SIZE,
-                    point_shape="circle",
-                    point_shading="flat",
-                )
-                if len(lit)
-                else None,
-            )
-            if len(lit):
+            if image is not None and lit_key == self._drawn.ahead_key:
+                ahead = self._drawn.nodes.pop("lit-ahead")
+                ahead.visible = True
+                self._node("lit", ahead)
+                self._drawn.ahead_key = None
+                sent = self._drawn.ahead_points
+            else:
+                handle, sent = self._lit_cloud("lit", cloud, image, pose, visible=True)
+                self._node("lit", handle)
+            if sent:
                 # Since a click here confirmed the mark (s): the server's share of the
                 # click-to-highlight time (bench/click_latency.py).
                 since = None
                 if self._confirmed_at is not None:
                     since = round(time.monotonic() - self._confirmed_at, 4)
                     self._confirmed_at = None
-                self.session.announce("highlight", points=len(lit), since_click=since)
+                self.session.announce("highlight", points=sent, since_click=since)
+        foreseen = self.session.foreseen
+        ahead_key = None
+        if foreseen is not None and foreseen[0] is cloud and foreseen[1] is not image:
+            ahead_key = (id(cloud), id(foreseen[1]))
+        if ahead_key != self._drawn.ahead_key:
+            self._drawn.ahead_key = ahead_key
+            self._drawn.sent_ahead += 1  # a path of its own: shown, it is the "lit" node
+            handle, self._drawn.ahead_points = (
+                self._lit_cloud(
+                    f"lit-{self._drawn.sent_ahead}", cloud, foreseen[1], pose, visible=False
+                )
+                if foreseen is not None and ahead_key is not None
+                else (None, 0)
+            )
+            self._node("lit-ahead", handle)
         if cloud_key != self._drawn.cloud_key:
             self._drawn.cloud_key = cloud_key
             points = cloud.points[voxel_first(cloud.points, CLOUD_VOXEL)]
@@ -399,6 +411,35 @@ class OperatorConsole:
                     visible=self._show_cloud,
                 ),
             )
+
+    def _lit_cloud(
+        self,
+        name: str,
+        cloud: FusedCloud,
+        image: np.ndarray | None,
+        pose: np.ndarray,
+        *,
+        visible: bool,
+    ) -> tuple[viser.SceneNodeHandle | None, int]:
+        """The points of `cloud` that the projector `image` lights, as a bright point cloud
+        node `name` (None when it lights none), and how many points it has."""
+        assert self._drawn.pixels is not None and self._drawn.pixels_of is cloud
+        lit = cloud.points[lit_by(image, self._drawn.pixels)] if image is not None else None
+        if lit is None or not len(lit):
+            return None, 0
+        points = to_world(lit[voxel_first(lit, LIT_VOXEL)], pose).astype(np.float32)
+        # Larger and bright, and drawn whether or not the cloud is: the projector's light
+        # on the object shows either way.
+        handle = self.server.scene.add_point_cloud(
+            f"{_ROOT}/{name}",
+            points=points,
+            colors=LIT,
+            point_size=LIT_POINT_SIZE,
+            point_shape="circle",
+            point_shading="flat",
+            visible=visible,
+        )
+        return handle, len(points)
 
     def _draw_laser(self) -> None:
         robot = self.session.robot

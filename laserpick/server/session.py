@@ -30,6 +30,7 @@ Frames: points in `base` (m) unless a method says `world`; angles in radians.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import threading
@@ -149,6 +150,18 @@ class _Capture:
     at: float
 
 
+@dataclass(frozen=True)
+class _Foreseen:
+    """A clicked mark worked out before the click that confirms it: the perception at
+    `point` (m, `base`) in `capture`, and the projector image lighting its target (None when
+    there is none)."""
+
+    capture: _Capture
+    point: np.ndarray
+    perception: Perception
+    lit: np.ndarray | None
+
+
 def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
     return None if a is None else [round(float(x), digits) for x in np.ravel(a)]
 
@@ -196,6 +209,13 @@ class Session:
         #: waits on a capture.
         self._view_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="laserpick-views")
         self._view_job: Future[None] | None = None
+        #: A clicked mark is worked out here as soon as it is aimed (`_foresee`), so that the
+        #: confirming click finds its target segmented and the highlight on its way.
+        self._foresight = ThreadPoolExecutor(
+            max_workers=1, thread_name_prefix="laserpick-foresight"
+        )
+        self._foresee_seqs = itertools.count(1)
+        self._foresee_seq = 0  #: the newest request; older ones not yet begun are dropped
         self._job_name = ""
         self._cancel = threading.Event()
         self._cancel_reason = "Cancelled by the operator."  #: why `_cancel` was set
@@ -230,6 +250,7 @@ class Session:
         self.message = "Ready. Aim the laser at an object."
         self._projection: np.ndarray | None = None
         self._capture: _Capture | None = None
+        self._foreseen: _Foreseen | None = None
         p = self.settings.perception
         self.views = ViewMemory(
             p.recall_spacing,
@@ -246,6 +267,7 @@ class Session:
         self.robot.halt()
         self._worker.shutdown(wait=True, cancel_futures=True)
         self._view_pool.shutdown(wait=True, cancel_futures=True)
+        self._foresight.shutdown(wait=True, cancel_futures=True)
         self._watchdog.join(timeout=1.0)
         self.robot.close()
 
@@ -389,8 +411,17 @@ class Session:
             self._after_aim()
             self._record(actor, "laser/aim", "ok")
 
-    def aim_at(self, actor: Actor, point: np.ndarray, frame: Literal["base", "world"]) -> None:
-        """Point the laser at a point (m) in `base` or `world`."""
+    def aim_at(
+        self,
+        actor: Actor,
+        point: np.ndarray,
+        frame: Literal["base", "world"],
+        *,
+        foresee: bool = False,
+    ) -> None:
+        """Point the laser at a point (m) in `base` or `world`. foresee: aimed at an object
+        by a click, work out the mark there at once (`_foresee`): a confirm at this very
+        point then finds it done."""
         p = self._to_base(np.asarray(point, dtype=float), frame)
         reach = self.settings.server.max_reach
         if np.linalg.norm(p[:2]) > reach:
@@ -403,6 +434,20 @@ class Session:
             self.robot.laser.aim_at(p)
             self._after_aim()
             self._record(actor, "laser/aim", "ok")
+            if foresee and self.state == TaskState.AIMING:
+                self._foresee(p)
+
+    def ray_point(
+        self, origin: np.ndarray, direction: np.ndarray, frame: Literal["base", "world"]
+    ) -> np.ndarray:
+        """Where a ray (a click in the 3D view) first meets the fused cloud (m, `base`).
+        ValueError when the ray misses everything."""
+        o = self._to_base(np.asarray(origin, dtype=float), frame)
+        d = self._to_base(np.asarray(direction, dtype=float), frame, direction=True)
+        hit = ray_hit(self.cloud().points, o, d, radius=self.settings.server.cloud_voxel)
+        if hit is None:
+            raise ValueError("the ray meets no point of the cloud")
+        return hit
 
     def aim_ray(
         self,
@@ -411,15 +456,11 @@ class Session:
         direction: np.ndarray,
         frame: Literal["base", "world"],
     ) -> np.ndarray:
-        """Point the laser where a ray (a click in the 3D view) first meets the fused cloud;
-        the hit point in `base` (m). ValueError when the ray misses everything."""
-        o = self._to_base(np.asarray(origin, dtype=float), frame)
-        d = self._to_base(np.asarray(direction, dtype=float), frame, direction=True)
-        cloud = self.cloud()
-        hit = ray_hit(cloud.points, o, d, radius=self.settings.server.cloud_voxel)
-        if hit is None:
-            raise ValueError("the ray meets no point of the cloud")
-        self.aim_at(actor, hit, "base")
+        """Point the laser where a ray (a click in the 3D view) first meets the fused cloud,
+        foreseeing the mark there (`aim_at`); the hit point in `base` (m). ValueError when
+        the ray misses everything."""
+        hit = self.ray_point(origin, direction, frame)
+        self.aim_at(actor, hit, "base", foresee=True)
         return hit
 
     def nudge(self, actor: Actor, dyaw: float, dpitch: float) -> None:
@@ -689,24 +730,57 @@ class Session:
 
     # --- the jobs (worker thread) -----------------------------------------------------------
 
+    def _foresee(self, point: np.ndarray) -> Future[_Foreseen | None]:
+        """Work out the mark at `point` (m, `base`) in the capture it was aimed in, on the
+        foresight thread: the perception a confirm there uses, and its highlight, which the
+        3D view sends ahead, hidden, to show at the confirm. Resolves to None when there is
+        no fresh capture (the scooter moved), or when a newer request came before it began."""
+        seq = self._foresee_seq = next(self._foresee_seqs)
+        return self._foresight.submit(self._work_out, self._capture, point, seq)
+
+    def _work_out(self, capture: _Capture | None, point: np.ndarray, seq: int) -> _Foreseen | None:
+        seen = self._foreseen
+        if seen is not None and seen.capture is capture and np.array_equal(seen.point, point):
+            return seen
+        if seq != self._foresee_seq or capture is None or capture is not self._fresh_capture():
+            return None
+        perception = perceive(
+            capture.frames, point=point, settings=self.settings.perception, cloud=capture.cloud
+        )
+        lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
+        seen = _Foreseen(capture, np.array(point, float), perception, lit)
+        self._foreseen = seen
+        with self._lock:
+            self._emit("foreseen")
+        return seen
+
+    @property
+    def foreseen(self) -> tuple[FusedCloud, np.ndarray] | None:
+        """The cloud and the projector image of the mark worked out ahead of its confirm,
+        while that capture is the latest: what the 3D view may send ahead, hidden."""
+        seen = self._foreseen
+        if seen is None or seen.lit is None or seen.capture is not self._capture:
+            return None
+        return seen.capture.cloud, seen.lit
+
     def _perceive_job(self, point: np.ndarray | None = None) -> None:
         """Capture, find the mark in the IR images, segment. With `point` (a confirming click,
-        m in `base`), the mark is that point, and a capture still fresh from aiming is used."""
-        fresh = self._fresh_capture() if point is not None else None
-        t0 = time.perf_counter()
-        frames = list(fresh.frames) if fresh is not None else self.robot.capture()
-        captured = time.perf_counter() - t0
-        perception = perceive(
-            frames,
-            point=point,
-            settings=self.settings.perception,
-            cloud=None if fresh is None else fresh.cloud,
-        )
-        if fresh is None:
-            # A fresh capture's cloud is remembered already: the same object, so the views
-            # do not send the whole cloud again just as the highlight should show.
+        m in `base`), the mark is that point, worked out in the capture it was aimed in while
+        that is still fresh (`_foresee`: mostly done before the click)."""
+        seen = self._foresee(point).result() if point is not None else None
+        if seen is not None:
+            perception, lit, captured = seen.perception, seen.lit, 0.0
+        else:
+            t0 = time.perf_counter()
+            frames = self.robot.capture()
+            captured = time.perf_counter() - t0
+            perception = perceive(frames, point=point, settings=self.settings.perception)
             self._remember(frames, perception.cloud)
-        lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
+            lit = (
+                highlight_points(self.projector, perception.target_points)
+                if perception.ok
+                else None
+            )
         with self._lock:
             self.task.timings = {"capture": captured, **perception.timings}
             if self._cancel.is_set():
