@@ -55,6 +55,9 @@ DROP_TRIES = 3
 FALL_STEP = 0.04
 #: Highest extra lift (m) to bring a held object clear before carrying it.
 RISE_MAX = 0.20
+#: rad: a grasp whose approach leans farther than this from the vertical is from the side,
+#: and is drawn back out along it after the lift (`Behaviours._withdraw`).
+WITHDRAW_STEEP = np.radians(30.0)
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
 #: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
@@ -364,8 +367,35 @@ class Behaviours:
                 self.robot.sleep(GRIPPER_TIME)
                 self.held = None
             return Outcome(failure, grasp, attempts, timings)
+        failure = self._withdraw(self.held)
+        if failure:  # the hand keeps what it holds: the session tucks it in
+            return Outcome(failure, grasp, attempts, timings)
         self.progress("Holding the object.")
         return Outcome(None, grasp, attempts, timings)
+
+    def _withdraw(self, held: Held) -> Failure | None:
+        """After a grasp from the side, draw the lifted hand straight back out along its
+        approach, level, by `approach_distance` (or half that where the whole is not clear):
+        out of a shelf's gap before the arm swings anywhere. A swing planned from inside the
+        69 cm shelf found no way out, or met the board above. A grasp from above (within
+        WITHDRAW_STEEP of the vertical) has risen out already."""
+        approach = held.grasp.pose[:3, 2]
+        level = np.hypot(*approach[:2])
+        if level < np.sin(WITHDRAW_STEEP):
+            return None
+        s = self.settings.motion
+        back = -np.append(approach[:2] / level, 0.0)
+        for distance in (s.approach_distance, s.approach_distance / 2):
+            T = tcp_pose(self._q())
+            T[:3, 3] += distance * back
+            path = cartesian_line(self._q(), T, s.cartesian_step)
+            if (
+                path is None
+                or not held.surroundings.clearance_ok(path, payload=held.points_tcp).all()
+            ):
+                continue
+            return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
+        return None
 
     def _gripping(self) -> bool:
         state = self.robot.gripper_state()

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from laserpick.behaviours import PLACE_YAWS, Behaviours, drop_candidates, turned_hand_xy
+from laserpick.behaviours import PLACE_YAWS, Behaviours, Held, drop_candidates, turned_hand_xy
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
 from laserpick.bench.truth import Captured
@@ -449,3 +449,45 @@ def test_a_motion_whose_start_the_arm_does_not_reach_fails_saying_so(robot):
     assert failure is not None and failure.kind == "execute"
     assert "stopped short of where approaching starts" in failure.message
     assert np.abs(robot.joint_state().q - q0).max() < 0.02, "the arm stays where it was"
+
+
+def _side_pose(x: float, y: float, z: float) -> np.ndarray:
+    """A TCP pose at (x, y, z) (m, `base`) with the hand level, approaching along +x and
+    closing across y."""
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    T[:3, 3] = x, y, z
+    return T
+
+
+def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
+    """Out of a shelf's gap before the arm swings anywhere: the lifted hand goes straight
+    back along its approach, level, 10 cm; not where a post stands in the way (the arm
+    stays, and the planner takes over); not from a grasp from above, which has risen out
+    already."""
+    b = Behaviours(robot)
+    free = CollisionChecker(np.zeros((0, 3)))
+    side = _side_pose(1.70, -0.30, 0.80)
+    q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
+    assert b.go_to(q_side, free, "test").ok
+    payload = np.zeros((1, 3))
+    held = Held(Grasp(pose=side, width=0.05), 0.05, payload, free)
+    assert b._withdraw(held) is None
+    np.testing.assert_allclose(
+        tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
+    )
+    # A post behind the hand, clear of it where it stands but in the way of 5 cm back.
+    assert b.go_to(q_side, free, "test").ok
+    for x in np.arange(1.55, 1.2, -0.01):
+        post = CollisionChecker(np.array([[x, -0.30, z] for z in np.arange(0.6, 1.0, 0.01)]))
+        half = cartesian_line(q_side, _side_pose(1.65, -0.30, 0.80))
+        if post.clearance_ok(q_side, payload=payload)[0] and not post.clearance_ok(half).all():
+            break
+    else:
+        pytest.fail("no post position blocks the way back but not the hand")
+    stood = robot.joint_state().q
+    assert b._withdraw(Held(held.grasp, 0.05, payload, post)) is None
+    np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
+    top = Held(Grasp(pose=_top_down(1.6, -0.3, 0.8), width=0.05), 0.05, payload, free)
+    assert b._withdraw(top) is None
+    np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
