@@ -196,11 +196,13 @@ def find_grasps(
     timings["detect"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     recalled = recalled or Recalled()
-    # The views saw the target from elsewhere: what they saw of it that is hidden now is
-    # the target, not an obstacle beside it. Its extent is the carry's model of it.
     support = seg.surface.height if seg.surface is not None else None
-    whole = carried_shape(target, support, voxel=TARGET_VOXEL)
-    blind = recalled.blind_points(perception.frames, whole, support)
+    blind = recalled.points
+    if len(blind):
+        # The views saw the target from elsewhere: what they saw of it that is hidden now
+        # is the target, not an obstacle beside it. Its extent is the carry's model of it.
+        whole = carried_shape(target, support, voxel=TARGET_VOXEL)
+        blind = recalled.blind_points(perception.frames, whole, support)
     world, surroundings = CollisionChecker.world_and_surroundings(
         np.vstack([cloud.points, blind]) if len(blind) else cloud.points,
         seg.indices,
