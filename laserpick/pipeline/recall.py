@@ -29,6 +29,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from laserpick.pipeline.cloud import fuse, voxel_first
+from laserpick.pipeline.collision import self_filter
 from laserpick.pipeline.free_space import hidden
 from laserpick.pipeline.types import DepthFrame
 from laserpick.settings import PerceptionSettings, get_settings
@@ -160,8 +161,14 @@ class ViewMemory:
         moved = math.hypot(pose[0] - last[0], pose[1] - last[1])
         return moved >= self.spacing or _turn(pose[2], last[2]) >= self.turn
 
-    def add(self, frames: Sequence[DepthFrame], pose: np.ndarray) -> None:
-        """Keep a capture taken at odometry `pose`; the oldest goes beyond `size`."""
+    def add(
+        self, frames: Sequence[DepthFrame], pose: np.ndarray, q_arm: np.ndarray | None = None
+    ) -> None:
+        """Keep a capture taken at odometry `pose`; the oldest goes beyond `size`. q_arm (6,)
+        (rad): the arm's joint angles in the capture (None: no arm in view). Its own points
+        are left out (`self_filter`), as the planner leaves them out of a capture now: carried
+        to where the scooter stands now, they would be a ghost of the arm, in the very place
+        it folds into (the stow after the first drop found no way home in every in-situ task)."""
         if self.size == 0 or not frames:
             return
         # The workspace box, reaching as much farther ahead as the views span: what lay
@@ -169,6 +176,8 @@ class ViewMemory:
         s = self.settings or get_settings().perception
         far = (s.workspace_max[0] + self.spacing * self.size, *s.workspace_max[1:])
         points = fuse(frames, s.model_copy(update={"workspace_max": far})).points
+        if q_arm is not None:
+            points = points[self_filter(points, q_arm)]
         view = View(tuple(frames), points[voxel_first(points, VIEW_VOXEL)], np.array(pose, float))
         with self._lock:
             self._views = (*self._views, view)[-self.size :]

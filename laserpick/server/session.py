@@ -639,14 +639,14 @@ class Session:
             self._view_job = self._view_pool.submit(self._take_view, robot)
 
     def _take_view(self, robot: SimRobot) -> None:
-        pose = robot.base_pose()
+        pose, q = robot.base_pose(), robot.joint_state().q
         try:
             frames = robot.capture()
         except Exception:  # a view is extra evidence; a drive goes on without it
             log.exception("A view on the way could not be captured.")
             return
         if robot is self.robot:  # not a view of a scene replaced meanwhile
-            self.views.add(frames, pose)
+            self.views.add(frames, pose, q)
 
     def _recalled(self) -> Recalled:
         """The views kept on the way in, in `base` as the scooter stands now."""
