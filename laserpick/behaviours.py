@@ -385,10 +385,12 @@ class Behaviours:
             return None
         s = self.settings.motion
         back = -np.append(approach[:2] / level, 0.0)
+        q = self._q()
+        here = tcp_pose(q)
         for distance in (s.approach_distance, s.approach_distance / 2):
-            T = tcp_pose(self._q())
+            T = here.copy()
             T[:3, 3] += distance * back
-            path = cartesian_line(self._q(), T, s.cartesian_step)
+            path = cartesian_line(q, T, s.cartesian_step)
             if (
                 path is None
                 or not held.surroundings.clearance_ok(path, payload=held.points_tcp).all()
