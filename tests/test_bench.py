@@ -8,6 +8,7 @@ import json
 import math
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -151,6 +152,41 @@ def test_a_trial_that_breaks_off_is_reported_not_lost(monkeypatch) -> None:
     assert len(out["errors"]) == 1
     assert "trial 1 (seed 11)" in out["errors"][0] and "simulated breakage" in out["errors"][0]
     assert "broke off" in markdown(out)
+
+
+PARENT_OF_A_POOL = """
+import os, sys, time
+from laserpick.bench.runner import worker_pool
+pool = worker_pool(1)
+print(pool.submit(os.getpid).result(), flush=True)
+time.sleep(60)
+"""
+
+
+def test_workers_end_when_the_bench_is_killed() -> None:
+    """A bench killed with SIGKILL cannot end its pool; its worker must notice and end itself."""
+    parent = subprocess.Popen(
+        [sys.executable, "-c", PARENT_OF_A_POOL], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        worker = int(parent.stdout.readline())
+        assert _running(worker)
+    finally:
+        parent.kill()
+        parent.wait()
+    deadline = time.monotonic() + 10.0
+    while _running(worker) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _running(worker), "the orphaned worker is still running"
+
+
+def _running(pid: int) -> bool:
+    """Whether process `pid` exists and is not a zombie waiting to be reaped."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return False
+    return "\nState:\tZ" not in status
 
 
 def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:

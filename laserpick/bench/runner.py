@@ -10,6 +10,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import sys
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterator
@@ -38,14 +39,38 @@ def run_trial(protocol: str, trial: int, seed: int, options: Options) -> Outcome
     return [a.as_dict() for a in attempts], None
 
 
+def _exit_with_parent(parent: int, period_s: float = 0.5) -> None:
+    """Worker initializer: end this worker once the process that started it is gone.
+
+    A parent killed by SIGTERM or SIGKILL gets no chance to end its pool, and the orphaned
+    workers would go on simulating for the rest of the run, taking the cores from whatever
+    runs next. An orphan is adopted by another process, so its parent pid changes."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(period_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def worker_pool(workers: int) -> ProcessPoolExecutor:
+    """A pool of `workers` fresh interpreters (spawn: no EGL context or thread is inherited)
+    that end themselves when this process goes away."""
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_exit_with_parent,
+        initargs=(os.getpid(),),
+    )
+
+
 def _local(protocol: str, seeds: list[int], options: Options, workers: int) -> Iterator[Outcome]:
     if workers <= 1:
         for trial, seed in enumerate(seeds):
             yield run_trial(protocol, trial, seed, options)
         return
-    # spawn: a fresh interpreter per worker, so no EGL context or thread is inherited
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    with worker_pool(workers) as pool:
         futures = [
             pool.submit(run_trial, protocol, trial, seed, options)
             for trial, seed in enumerate(seeds)
