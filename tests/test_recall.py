@@ -11,18 +11,27 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.collision import CollisionChecker, self_filter
+from laserpick.pipeline.collision import CollisionChecker, self_filter, within_reach
 from laserpick.pipeline.free_space import hidden, seen_free
-from laserpick.pipeline.recall import NOW_TOLERANCE, Recalled, ViewMemory, motion, on_target
+from laserpick.pipeline.recall import (
+    NOW_TOLERANCE,
+    VIEW_VOXEL,
+    Recalled,
+    ViewMemory,
+    motion,
+    on_target,
+)
 from laserpick.pipeline.types import DepthFrame
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.server.session import Actor, Session
 from laserpick.transforms import invert, planar_pose
 
-WALL_X = 3.0  #: m, in the odometry's frame: a wall facing the scooter's start
+WALL_X = 2.0  #: m, in the odometry's frame: a wall facing the scooter's start, in part
+#: within the arm's reach
 TOL = 0.006
 
 
@@ -105,6 +114,22 @@ def test_the_memory_keeps_a_view_each_spacing_or_turn_the_last_few_and_only_for_
         ViewMemory(0.0, 0.3, 4, 60.0)
 
 
+def test_only_what_the_arm_could_touch_is_recalled():
+    """The wall's points out of the arm's reach are left out; every part of it within reach
+    is kept, to the views' thinning."""
+    then = np.array([0.0, 0.0, 0.0])
+    view = _wall_frame(then)
+    memory = ViewMemory(0.1, 0.1, 4, 60.0)
+    memory.add([view], then)
+    kept = memory.recall(then, now=0.0).points
+    seen = fuse([view]).points
+    assert within_reach(kept).all()
+    assert (~within_reach(seen)).sum() > 100  # the crop had something to leave out
+    near = seen[within_reach(seen)]
+    d, _ = cKDTree(kept).query(near)
+    assert d.max() <= VIEW_VOXEL * math.sqrt(3)
+
+
 def test_a_view_adds_its_points_only_where_no_camera_sees_now():
     """Of the points a view saw of the wall, those a camera sees now are the current
     capture's to say; those now outside every camera's view, and those hidden behind
@@ -132,7 +157,7 @@ def test_a_view_adds_its_points_only_where_no_camera_sees_now():
     # target takes its points with it, and the wall's points beyond stay.
     strip = np.abs(wall[:, 1]) < 0.1
     kept = recalled.blind_points([], wall[strip], support=0.0)
-    assert len(kept) == len(wall) - strip.sum() and np.min(np.abs(kept[:, 1])) > 0.1
+    assert len(kept) == len(wall) - strip.sum() and np.min(np.abs(kept[:, 1])) >= 0.1 - 1e-6
     assert len(Recalled().blind_points([left])) == 0
 
 

@@ -231,6 +231,15 @@ def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.
     return keep
 
 
+def within_reach(points: np.ndarray) -> np.ndarray:
+    """Mask (N,) of the points (N, 3), `base`, m, that the arm, its hand and what the hand
+    holds could touch: finite and within REACH of the shoulder. No other point can matter to
+    a collision check."""
+    d = np.asarray(points, np.float32).reshape(-1, 3) - _SHOULDER.astype(np.float32)
+    with np.errstate(invalid="ignore"):
+        return np.einsum("ij,ij->i", d, d) < REACH**2  # NaN compares false: it drops out
+
+
 def obstacle_mask(
     points: np.ndarray, *, voxel: float = 0.01, q_self: np.ndarray | None = None
 ) -> np.ndarray:
@@ -238,10 +247,9 @@ def obstacle_mask(
     the floor's clearance (no sphere goes lower: the floor itself is checked exactly), one
     per `voxel` (m; 0 keeps all), not the arm itself at q_self (rad) if given, and not the
     scooter (inside its keep-out boxes, which the checker tests exactly)."""
-    d = np.asarray(points, np.float32) - _SHOULDER.astype(np.float32)
     with np.errstate(invalid="ignore"):
-        mask = (np.einsum("ij,ij->i", d, d) < REACH**2) & (points[:, 2] > FLOOR_CLEARANCE)
-    idx = np.flatnonzero(mask)  # NaN compares false: non-finite points drop out here
+        mask = within_reach(points) & (points[:, 2] > FLOOR_CLEARANCE)
+    idx = np.flatnonzero(mask)
     if voxel > 0:
         idx = idx[thin(points[idx], voxel)]
     if q_self is not None:
