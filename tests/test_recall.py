@@ -152,7 +152,6 @@ def test_a_view_adds_its_points_only_where_no_camera_sees_now():
     assert len(recalled.blind_points([screened])) == len(wall)
     # The same camera, reading the wall as the view did, sees every point: none is added.
     assert len(recalled.blind_points([view])) == 0
-    # The target's own points, and those within 2 cm of them, are not obstacles.
     # The target's own points are not obstacles (`on_target`): a strip of the wall as the
     # target takes its points with it, and the wall's points beyond stay.
     strip = np.abs(wall[:, 1]) < 0.1

@@ -203,9 +203,10 @@ class SceneViewer:
         viewer.stop()
 
     `lite=True` draws for browsers without a GPU: no shadows, no environment lighting and
-    flat toon shading. Headless Chromium's software WebGL (SwiftShader) then draws a frame of
-    the isolation scene at 900 x 600 in about 60 ms instead of 200 ms, and every click waits
-    for the frame in progress. `controls=False` leaves out the Pause/Resume
+    flat toon shading. Headless Chromium's software WebGL (SwiftShader) then drew a frame of
+    the isolation scene at 900 x 600 in about 60 ms instead of 200 ms on this machine (when
+    measured; it varies with the machine's load several fold), and every click waits for the
+    frame in progress. `controls=False` leaves out the Pause/Resume
     button (a view-only console, for a port that is reachable from other hosts). The nodes are
     created in the constructor. `update()` pushes one pose burst by hand (tests, headless
     stepping); `set_simulation()` swaps in a new Simulation (a scene reset).
