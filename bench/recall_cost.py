@@ -1,10 +1,11 @@
 """What the views from the way in cost the grasp decision, with and without their crop to the
 arm's reach (`collision.within_reach`, applied in `ViewMemory.recall`).
 
-The scooter on `isolation` (seed 1) drives 1 m back and in again, so that the session keeps
-its views of the way in; then, for every object marked at its visible top, it times the
-recall and `find_grasps` (detect and filter) with those views, best of `--repeats`, once as
-the code does it and once with every recalled point kept. Nothing is executed.
+The scooter on `isolation` (seed 1) drives 1 m back and in again (tests/driving.py), so
+that the session keeps its views of the way in; then, for every object marked at its
+visible top, it times the recall and `find_grasps` (detect and filter) with those views,
+best of `--repeats`, once as the code does it and once with every recalled point kept.
+Nothing is executed.
 
     MUJOCO_GL=egl .venv/bin/python bench/recall_cost.py [--repeats 3]
 """
@@ -12,7 +13,9 @@ the code does it and once with every recalled point kept. Nothing is executed.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -26,18 +29,8 @@ from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.server.session import Actor, Session
 
-
-def drive_back_and_in(session: Session) -> None:
-    """1 m back at 0.4 m/s and in again, pausing between, as tests/test_recall.py does."""
-    robot, actor = session.robot, Actor("bench")
-    robot.sim.settle(0.3)
-    for v in (-0.4, 0.4):
-        for _ in range(25):
-            session.drive(actor, v, 0.0, 0.3)
-            robot.sleep(0.1)
-        for _ in range(10):
-            session.drive(actor, 0.0, 0.0, 0.3)
-            robot.sleep(0.1)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from driving import drive_back_and_in
 
 
 def main() -> None:
@@ -48,7 +41,8 @@ def main() -> None:
     truth_cloud = fuse(truth.frames)
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
-        drive_back_and_in(session)
+        session.robot.sim.settle(0.3)
+        drive_back_and_in(session, Actor("bench"))
         frames = session.robot.capture()
         q = session.robot.joint_state().q
         cropped = recall.within_reach

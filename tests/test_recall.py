@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from driving import drive_back_and_in
 from scipy.spatial import cKDTree
 
 from laserpick.pipeline.cloud import fuse
@@ -169,13 +170,7 @@ def test_the_blind_spot_beside_the_parked_scooter_was_seen_on_the_way_in():
     try:
         robot, actor = session.robot, Actor("bench")
         robot.sim.settle(0.3)
-        for v in (-0.4, 0.4):
-            for _ in range(25):
-                session.drive(actor, v, 0.0, 0.3)
-                robot.sleep(0.1)
-            for _ in range(10):
-                session.drive(actor, 0.0, 0.0, 0.3)
-                robot.sleep(0.1)
+        drive_back_and_in(session, actor)
         kept = len(session.views)
         assert kept == session.settings.perception.recall_views
         frames = robot.capture()
