@@ -40,12 +40,12 @@ def main() -> None:
     truth = capture("isolation", seed=1)
     truth_cloud = fuse(truth.frames)
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    cropped = recall.within_reach
     try:
         session.robot.sim.settle(0.3)
         drive_back_and_in(session, Actor("bench"))
         frames = session.robot.capture()
         q = session.robot.joint_state().q
-        cropped = recall.within_reach
         totals = {}
         for label, reach in (("cropped", cropped), ("all kept", lambda p: np.ones(len(p), bool))):
             recall.within_reach = reach
@@ -78,12 +78,12 @@ def main() -> None:
                     f"  {p.instance:<18} recall + decision {1000 * took:4.0f} ms"
                     f"  (detect {1000 * t['detect']:4.0f}, filter {1000 * t['filter']:4.0f})"
                 )
-        recall.within_reach = cropped
         print(
             f"\nsum over the objects: {1000 * totals['cropped']:.0f} ms cropped,"
             f" {1000 * totals['all kept']:.0f} ms with every recalled point"
         )
     finally:
+        recall.within_reach = cropped
         session.close()
 
 

@@ -229,7 +229,11 @@ def find_grasps(
         timings["filter"] += time.perf_counter() - t0
         return True
 
-    if strategy == "gpd" and not any(g.ik is not None for g in checked):
+    def none_reachable() -> bool:
+        return not any(g.ik is not None for g in checked)
+
+    gpd = strategy == "gpd"
+    if gpd and none_reachable():
         # GPD needs both sides of a grasp in view. Seen from the front only (a tall bottle
         # off to the side has no seen face opposite a seen face), its back is guessed by
         # symmetry, as Bohg et al. complete a partial view, and the detection runs again.
@@ -240,16 +244,13 @@ def find_grasps(
     # for the hand toward them. The centroid top grasp (Jeeves') is then the fallback. It
     # goes before the tilted pass: it costs a millisecond where the tilted pass costs half a
     # second, and in the open, where nothing is above the object, it is what serves.
-    gpd = strategy == "gpd"
-    if gpd and not any(g.ik is not None for g in checked) and add("vertical"):
+    if gpd and none_reachable() and add("vertical") and not none_reachable():
         strategy = "vertical"
-    if gpd and s.grasp.gpd_tilts_deg and not any(g.ik is not None for g in checked):
+    if gpd and s.grasp.gpd_tilts_deg and none_reachable():
         # Under a shelf's board a low object lying pointed at the robot offers only grasps
         # from above, across its girth, and the wrist does not fit above it; from the front
         # and above, with the hand tilted about its closing axis, it does.
         add("gpd", complete=True, tilted=True, most=COMPLETED_MAX)
-        if any(g.ik is not None for g in checked):
-            strategy = "gpd"
     if isinstance(found, Failure) and not checked:
         return found
     if not checked:
