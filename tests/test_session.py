@@ -102,3 +102,25 @@ def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> 
         console.stop()
         session.close()
         server.stop()
+
+
+def test_a_drive_that_overtakes_the_stop_sent_after_it_is_dropped() -> None:
+    """Two requests on two connections can be handled in either order (reproduced against a
+    real server, where it kept the base going 8 cm past the release). Numbered drives make
+    the stop stick: the drive numbered before it is dropped; a newer one drives again."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    try:
+        actor = Actor("console", session.lease.acquire("test", "console"))
+        x0 = session.robot.base_pose()[0]
+        session.drive(actor, 0.0, 0.0, 0.1, seq=8)  # the stop on release, handled first
+        session.drive(actor, -0.3, 0.0, 0.5, seq=7)  # the drive sent before it
+        time.sleep(0.6)
+        assert abs(session.robot.base_pose()[0] - x0) < 1e-3, "the older drive was applied"
+        session.lease.heartbeat(actor.token)  # alive, or the watchdog halts the drive
+        session.drive(actor, -0.3, 0.0, 0.3, seq=9)
+        _wait(lambda: session.robot.base_pose()[0] < x0 - 0.01, timeout=5.0)
+        # Unnumbered commands (one connection, in order) are applied as they come.
+        session.drive(actor, 0.0, 0.0, 0.1)
+        assert session._drive_seq == (actor.token, 9)
+    finally:
+        session.close()

@@ -502,7 +502,7 @@ def create_app(
     @app.post(f"{API}/drive", response_model=S.Ok, tags=["motion"], responses=conflict)
     def drive(body: S.DriveRequest, who: Commander) -> S.Ok:
         """Drive the base (a dead-man: the command lapses after `duration`, at most 0.5 s)."""
-        return guarded(lambda: session.drive(who, body.v, body.w, body.duration))
+        return guarded(lambda: session.drive(who, body.v, body.w, body.duration, body.seq))
 
     @app.post(f"{API}/stop", response_model=S.Ok, tags=["motion"], openapi_extra=token_optional)
     def stop(creds: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]) -> S.Ok:

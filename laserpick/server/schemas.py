@@ -114,6 +114,14 @@ class DriveRequest(_Body):
     v: Annotated[float, Field(allow_inf_nan=False, ge=-dims.BASE_V_MAX, le=dims.BASE_V_MAX)]
     w: Annotated[float, Field(allow_inf_nan=False, ge=-dims.BASE_W_MAX, le=dims.BASE_W_MAX)] = 0.0
     duration: Annotated[float, Field(allow_inf_nan=False, gt=0.0, le=0.5)] = 0.5
+    seq: int | None = Field(
+        None,
+        ge=0,
+        le=2**53 - 1,
+        description="Optional: number the drive commands of one token in the order sent. "
+        "One older than the last applied is dropped, so a stop sent on another connection "
+        "is never overtaken by the drive sent before it.",
+    )
 
 
 class SceneRequest(_Body):

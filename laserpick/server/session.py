@@ -223,6 +223,8 @@ class Session:
         self._motion_token: str | None = None  #: whose heartbeat the running motion needs
         self._drive_token: str | None = None
         self._drive_until = 0.0
+        #: (token, seq) of the last numbered drive applied: older ones are dropped.
+        self._drive_seq: tuple[str | None, int] = (None, -1)
         self.mode: Mode = "pick_and_drop"
         self.selection: Selection = "auto"
         self.strategy: StrategyName = "gpd"
@@ -605,12 +607,24 @@ class Session:
             self._set(state, "Holding." if state == TaskState.HOLDING else "Ready.")
             self._record(actor, "resync", "ok")
 
-    def drive(self, actor: Actor, v: float, w: float, duration: float) -> None:
+    def drive(
+        self, actor: Actor, v: float, w: float, duration: float, seq: int | None = None
+    ) -> None:
         """Drive the base at v (m/s) and w (rad/s) for at most `duration` s (<= 0.5 s: a
-        dead-man; send it again to keep going). What was perceived is stale afterwards."""
+        dead-man; send it again to keep going). What was perceived is stale afterwards.
+
+        `seq` numbers a client's drive commands. Requests on different connections can be
+        handled out of order, and a drive overtaking the stop sent after it would move the
+        base for another half second; so a numbered command older than the last one applied
+        from the same token is dropped."""
         with self._lock:
             self._require(actor, "drive", AIMABLE)
             self._require_motion(actor, "drive")
+            if seq is not None:
+                last_token, last_seq = self._drive_seq
+                if actor.token == last_token and seq <= last_seq:
+                    return
+                self._drive_seq = (actor.token, seq)
             self.robot.drive(v, w, duration)
             self._drive_token = actor.token
             self._drive_until = time.monotonic() + duration

@@ -485,8 +485,12 @@ function driveSpeeds() {
   const v = +settings.speed;
   return [f * v, t * Math.min(1, 2 * v)];  // turn: rad/s, twice the speed in m/s
 }
+// Drive commands are numbered: fetches on separate connections can reach the server out of
+// order, and the server drops a drive older than one it applied, so the stop sent on release
+// is never overtaken by the drive sent just before it.
+let driveSeq = 0;
 function sendDrive(v, w, duration = 0.5) {
-  return command("/drive", { v: +v.toFixed(3), w: +w.toFixed(3), duration });
+  return command("/drive", { v: +v.toFixed(3), w: +w.toFixed(3), duration, seq: ++driveSeq });
 }
 // source: "pointer", "keys" or "pad"; wish: [f, t] or null to let go. coast: a short press
 // (a click) lets its 0.5 s step run out instead of stopping at once.
