@@ -604,8 +604,9 @@ class Behaviours:
         mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
-        down from 10 cm above, guarded, then the hand opens and rises straight back, and
-        the arm stows around the object where it now stands.
+        down from 10 cm above until the surface is felt (`place_contact_force`), then the
+        hand opens and rises straight back, and the arm stows around the object where it
+        now stands. Nothing felt by `place_below` under the rest: the hand keeps it.
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -636,11 +637,21 @@ class Behaviours:
         if lost is not None:
             return lost
         lowering = timed(down, s, tcp_speed=s.approach_speed)
-        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.guard_force)
+        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
         failure = self._run(guarded, "lowering the object")
-        if failure is not None and "unexpected contact" not in failure.message:
+        if failure is None:
+            # Past the surface's height and nothing felt (EL-E 000 section 4.5): the surface
+            # is not where it was seen. Keep the object, and rise to wait for another mark.
+            up = cartesian_line(self._q(), T_above, s.cartesian_step)
+            if up is not None:
+                self._run(timed(up, s, tcp_speed=s.approach_speed), "rising from the place")
+            past = f"{s.place_below * 100:.0f} cm past where it should touch the surface"
+            return Outcome(
+                Failure("execute", f"I lowered the object {past}, felt nothing, and kept it.")
+            )
+        if "unexpected contact" not in failure.message:
             return Outcome(failure)
-        # Touching the surface early (a guard stop) is where the object should be let go.
+        # The guard stop is the surface met: let go there, with no drop to roll from.
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
@@ -672,7 +683,8 @@ class Behaviours:
         self, held: Held, spot: np.ndarray, q_now: np.ndarray, checker: CollisionChecker
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | Failure:
         """Where to set the object down at `spot` (m, `base`): the joint angles above it, the
-        straight path down, and the pose above. The grasp's orientation is kept, so that the
+        straight path down (to `place_below` under the object's rest, where the descent
+        looks for the surface), and the pose above. The grasp's orientation is kept, so that the
         object stands as it stood, turned about the vertical if the arm cannot reach it
         unturned (PLACE_YAWS): a turned object still stands upright, and where it would have
         stood unturned (the hand over the mark, 004 section 7.3)."""
@@ -681,15 +693,13 @@ class Behaviours:
         # The middle of the held object, from the hand (m, `base` axes at the grasp).
         pts = held.points_tcp @ held.grasp.pose[:3, :3].T
         middle = (pts.min(axis=0) + pts.max(axis=0)) / 2 if len(pts) else np.zeros(3)
+        rest = spot[2] + held.height_above_support  # the hand's height with the object down
         for dyaw in PLACE_YAWS:
             T_place = held.grasp.pose.copy()
             T_place[:3, :3] = rotz(dyaw) @ T_place[:3, :3]
-            T_place[:3, 3] = [
-                *turned_hand_xy(spot[:2], middle[:2], dyaw),
-                spot[2] + held.height_above_support + s.place_clearance,
-            ]
+            T_place[:3, 3] = [*turned_hand_xy(spot[:2], middle[:2], dyaw), rest - s.place_below]
             T_above = T_place.copy()
-            T_above[2, 3] += s.approach_distance
+            T_above[2, 3] = rest + s.approach_distance
             # Nearest the poses in front first, whether the object is tucked in or raised.
             clear = [
                 q

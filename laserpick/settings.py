@@ -544,8 +544,20 @@ class MotionSettings(BaseModel):
         description="Failed joint-space searches in one pick before no more grasps are tried:"
         " each takes seconds, and a user should not wait minutes for a 'no'. Ours.",
     )
-    place_clearance: float = Field(
-        0.01, ge=0, description="Height (m) above the computed resting pose to release at."
+    place_below: float = Field(
+        0.02,
+        ge=0,
+        description="How far (m) below the computed resting pose the guarded descent of a"
+        " place may go to meet the surface; the hand opens where it does (EL-E 000 section"
+        " 4.5). Met nowhere, the place failed and the hand keeps the object. Ours: a"
+        " release 1 cm above the rest let a can lying on its side roll 3 cm off its mark.",
+    )
+    place_contact_force: float = Field(
+        10.0,
+        gt=0,
+        description="Contact force (N) on the hand or the held object that ends a place's"
+        " descent: the surface was met. EL-E felt 2 N at its fingers; an arm's"
+        " joint-current estimate is coarser. Ours.",
     )
 
 
