@@ -119,7 +119,7 @@ def test_a_drive_that_overtakes_the_stop_sent_after_it_is_dropped() -> None:
         session.lease.heartbeat(actor.token)  # alive, or the watchdog halts the drive
         session.drive(actor, -0.3, 0.0, 0.3, seq=9)
         _wait(lambda: session.robot.base_pose()[0] < x0 - 0.01, timeout=5.0)
-        # Unnumbered commands (one connection, in order) are applied as they come.
+        # An unnumbered command (a client on one connection, in order) leaves the count alone.
         session.drive(actor, 0.0, 0.0, 0.1)
         assert session._drive_seq == (actor.token, 9)
     finally:
