@@ -642,9 +642,7 @@ class Behaviours:
         if failure is None:
             # Past the surface's height and nothing felt (EL-E 000 section 4.5): the surface
             # is not where it was seen. Keep the object, and rise to wait for another mark.
-            up = cartesian_line(self._q(), T_above, s.cartesian_step)
-            if up is not None:
-                self._run(timed(up, s, tcp_speed=s.approach_speed), "rising from the place")
+            self._rise_straight(T_above, "rising from the place")
             past = f"{s.place_below * 100:.0f} cm past where it should touch the surface"
             return Outcome(
                 Failure("execute", f"I lowered the object {past}, felt nothing, and kept it.")
@@ -656,9 +654,7 @@ class Behaviours:
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
         T_release = tcp_pose(self._q())
-        up = cartesian_line(self._q(), T_above, s.cartesian_step)
-        if up is not None:
-            self._run(timed(up, s, tcp_speed=s.approach_speed), "rising from the object")
+        self._rise_straight(T_above, "rising from the object")
         # Stowed around the object where it now stands: the unchecked moves of a stow swept
         # the hand through it from the 87 cm counter (4 of 39 pick-place tasks ended with
         # the object pushed 12-20 cm away or off the counter).
@@ -678,6 +674,14 @@ class Behaviours:
             return Outcome(failure, held.grasp, spot=spot)
         self.progress("Placed.")
         return Outcome(None, held.grasp, spot=spot)
+
+    def _rise_straight(self, T: np.ndarray, what: str) -> None:
+        """Rise in a straight line to TCP pose T (4, 4, `base`) at the approach speed, if the
+        arm can (no check for collisions: the way back up is the way it came down)."""
+        s = self.settings.motion
+        up = cartesian_line(self._q(), T, s.cartesian_step)
+        if up is not None:
+            self._run(timed(up, s, tcp_speed=s.approach_speed), what)
 
     def _place_poses(
         self, held: Held, spot: np.ndarray, q_now: np.ndarray, checker: CollisionChecker
