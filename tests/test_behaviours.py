@@ -133,6 +133,26 @@ def test_with_both_ready_poses_filled_the_arm_stows_by_a_search(robot):
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
 
 
+def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket(robot):
+    """Parked at a shelf, whose boards fill both ready poses, the arm that has let go over
+    the basket folds away from there (11 of 67 in-situ attempts once ended with the object
+    in the basket and no way to ready)."""
+    name = "mug_1"
+    b, referee = _pick(robot, name)
+    assert b.held is not None
+    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
+    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    filled = CollisionChecker(np.vstack([b.held.surroundings.points, board]))
+    assert not filled.clearance_ok(dims.UR5_READY_Q)[0]
+    assert not filled.clearance_ok(dims.UR5_HIGH_READY_Q)[0]
+    b.held = dataclasses.replace(b.held, surroundings=filled)
+    dropped = b.drop_in_basket()
+    assert dropped.ok, dropped.failure
+    robot.sleep(1.0)
+    assert referee.in_basket(name)
+    assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
+
+
 def _top_down(x: float, y: float, z: float) -> np.ndarray:
     """A TCP pose at (x, y, z) in `base`, the gripper pointing down."""
     pose = np.eye(4)
