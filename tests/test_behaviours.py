@@ -358,6 +358,34 @@ def test_a_rise_stops_before_the_arm_comes_near_anything(robot):
     assert tcp_pose(robot.joint_state().q)[2, 3] - z0 == pytest.approx(0.05, abs=0.01)
 
 
+def test_a_rise_that_straight_up_would_bring_the_arm_near_something_reaches_out(robot):
+    """A hand close before the arm's mount, raised straight, swings the elbow back into the
+    sensor posts. The stand-in surroundings block the arm above 3 cm over the hand unless
+    it reaches out too, and the held object until it is 4 cm up: the rise takes one step,
+    up and out, and ends clear."""
+    b, _ = _pick(robot, "mug_1")
+    assert b.held is not None
+    T0 = tcp_pose(robot.joint_state().q)
+    out = T0[:2, 3] - dims.ARM_MOUNT_POS[:2]
+    out /= np.linalg.norm(out)
+
+    class Surroundings(CollisionChecker):
+        def clearance_ok(self, Q, *, payload=None, **kw):
+            T = tcp_pose(np.atleast_2d(Q))
+            up = T[:, 2, 3] - T0[2, 3]
+            reached = (T[:, :2, 3] - T0[:2, 3]) @ out
+            if payload is not None:
+                return up > 0.04
+            return (up < 0.03) | (reached > 0.5 * up)
+
+    surroundings = Surroundings(np.zeros((0, 3)))
+    assert b._rise_clear(surroundings, b.held.points_tcp) is None
+    T = tcp_pose(robot.joint_state().q)
+    assert T[2, 3] - T0[2, 3] == pytest.approx(0.05, abs=0.01)
+    assert (T[:2, 3] - T0[:2, 3]) @ out == pytest.approx(0.05, abs=0.01)
+    assert surroundings.clearance_ok(robot.joint_state().q, payload=b.held.points_tcp)[0]
+
+
 def test_an_open_hand_among_what_it_let_go_of_rises_clear_before_it_stows(robot):
     """After a place whose lowering a touch stopped short, the straight rise back leaves the
     open hand about the object's top, and no stow can start there (2 of 39 pick-place tasks
