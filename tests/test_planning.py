@@ -399,6 +399,23 @@ def test_plan_pick_refuses_a_grasp_under_the_table():
     assert isinstance(plan, Failure) and plan.kind == "ik_plan"
 
 
+def test_the_hand_may_grasp_a_low_object_on_the_floor_but_not_reach_into_it():
+    """A 2.5 cm tissue packet on the floor, grasped from above with the fingertips 5 mm over
+    the floor (`vertical_grasp`): the hand at its grasp may come as near the floor as to a
+    table's points (every such grasp was once refused: "the hand would hit something beside
+    the object"). With the fingertips 5 mm into the floor it is refused."""
+    s = get_settings()
+    half_pad = s.grasp.pad_depth / 2
+    plans = {}
+    for tips in (0.005, -0.005):
+        q = ik_tcp(top_grasp(1.55, -0.30, tips + half_pad), dims.UR5_READY_Q)[0]
+        world = CollisionChecker(EMPTY)
+        plans[tips] = plan_pick(dims.UR5_READY_Q, q, world, world, np.random.default_rng(0))
+    assert not isinstance(plans[0.005], Failure), plans[0.005]
+    refused = plans[-0.005]
+    assert isinstance(refused, Failure) and "hit something beside" in refused.message
+
+
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_checker_ignores_non_finite_points(bad):
     pts = np.array([[1.5, -0.3, bad], [5.0, 5.0, 5.0]])

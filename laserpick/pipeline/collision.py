@@ -435,7 +435,9 @@ class CollisionChecker:
         its body (B, S, K), and of the cloud (B, S)."""
         B, S, _ = centres.shape
         reach = radius[None, :] + margin
-        floor = centres[..., 2] < radius + FLOOR_CLEARANCE
+        # A negative margin (the hand at its grasp may touch the support) holds for the
+        # floor too: for an object on the floor, the floor is the support.
+        floor = centres[..., 2] < radius + (FLOOR_CLEARANCE if margin >= 0 else margin)
         boxes = (_box_gaps(centres) < reach[..., None]) & _CHECKED[body]
         cloud = np.zeros((B, S), bool)
         if self.tree is not None:
