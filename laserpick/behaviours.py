@@ -501,16 +501,17 @@ class Behaviours:
         place the open hand is still about the object it let go of.
         A step that would bring the arm itself near anything is not taken: a hand held out
         level and raised swings the elbow back over the scooter, into the tiller and the
-        sensor posts, and no path leaves from there. Where straight up does, the step also
-        reaches out RISE_OUT, away from the arm's mount, which keeps the elbow forward.
-        hand_on_the_way: whether the hand is kept clear on each step too (not when it starts
-        among what it let go of)."""
+        sensor posts, and no path leaves from there. Where straight up does, a held object
+        may instead rise and reach out RISE_OUT, away from the arm's mount, which keeps the
+        elbow forward: only where that step ends with the object clear (out of a shelf's
+        gap, it would carry the object deeper in). hand_on_the_way: whether the hand is kept
+        clear on each step too (not when it starts among what it let go of)."""
         s = self.settings.motion
         risen = 0.0
         while not checker.clearance_ok(self._q(), payload=payload)[0]:
             if risen >= RISE_MAX:
                 return None  # let the planner say it found no way
-            path = self._rise_step(checker, hand_on_the_way)
+            path = self._rise_step(checker, payload, hand_on_the_way)
             if path is None:
                 return None
             failure = self._run(timed(path, s, tcp_speed=s.approach_speed), "lifting clear")
@@ -519,20 +520,24 @@ class Behaviours:
             risen += RISE_STEP
         return None
 
-    def _rise_step(self, checker: CollisionChecker, hand: bool) -> np.ndarray | None:
-        """The joint path (N, 6) of one RISE_STEP up, straight or reaching out RISE_OUT from
-        the arm's mount, whichever keeps the arm (and the hand, if `hand`) clear first;
-        None when neither does."""
+    def _rise_step(
+        self, checker: CollisionChecker, payload: np.ndarray | None, hand: bool
+    ) -> np.ndarray | None:
+        """The joint path (N, 6) of one RISE_STEP up that keeps the arm (and the hand, if
+        `hand`) clear of `checker`: straight, or, holding `payload`, reaching out RISE_OUT
+        from the arm's mount where that brings the payload clear. None when neither does."""
         q = self._q()
         here = tcp_pose(q)
         out = here[:2, 3] - dims.ARM_MOUNT_POS[:2]
         out = out / max(float(np.linalg.norm(out)), 1e-6)
-        for reach in (0.0, RISE_OUT):
+        for reach in (0.0, RISE_OUT) if payload is not None else (0.0,):
             T = here.copy()
             T[:2, 3] += reach * out
             T[2, 3] += RISE_STEP
             path = cartesian_line(q, T, self.settings.motion.cartesian_step)
-            if path is not None and checker.clearance_ok(path, hand=hand).all():
+            if path is None or not checker.clearance_ok(path, hand=hand).all():
+                continue
+            if reach == 0.0 or checker.clearance_ok(path[-1], payload=payload)[0]:
                 return path
         return None
 

@@ -362,7 +362,8 @@ def test_a_rise_that_straight_up_would_bring_the_arm_near_something_reaches_out(
     """A hand close before the arm's mount, raised straight, swings the elbow back into the
     sensor posts. The stand-in surroundings block the arm above 3 cm over the hand unless
     it reaches out too, and the held object until it is 4 cm up: the rise takes one step,
-    up and out, and ends clear."""
+    up and out, and ends clear. Where that step would not bring the object clear (out of a
+    shelf's gap, deeper in), it is not taken."""
     b, _ = _pick(robot, "mug_1")
     assert b.held is not None
     T0 = tcp_pose(robot.joint_state().q)
@@ -378,6 +379,14 @@ def test_a_rise_that_straight_up_would_bring_the_arm_near_something_reaches_out(
                 return up > 0.04
             return (up < 0.03) | (reached > 0.5 * up)
 
+    class Shelf(Surroundings):
+        def clearance_ok(self, Q, *, payload=None, **kw):
+            if payload is not None:  # a step out would carry the object deeper in
+                return np.zeros(len(np.atleast_2d(Q)), bool)
+            return super().clearance_ok(Q, **kw)
+
+    assert b._rise_clear(Shelf(np.zeros((0, 3))), b.held.points_tcp) is None
+    assert np.allclose(tcp_pose(robot.joint_state().q)[:3, 3], T0[:3, 3], atol=0.005)
     surroundings = Surroundings(np.zeros((0, 3)))
     assert b._rise_clear(surroundings, b.held.points_tcp) is None
     T = tcp_pose(robot.joint_state().q)
