@@ -416,6 +416,31 @@ def test_the_hand_may_grasp_a_low_object_on_the_floor_but_not_reach_into_it():
     assert isinstance(refused, Failure) and "hit something beside" in refused.message
 
 
+def test_what_stands_between_the_open_fingers_is_closed_on_and_what_stands_beside_is_not():
+    """A packet's side face that the segmentation left out of the target stands between the
+    open fingers of a grasp from above: the housing's spheres reach down there, but the real
+    housing does not, so the grasp is planned. The same face where a finger comes down is
+    hit."""
+    top = 0.46
+    T = top_grasp(1.55, -0.30, top + 0.016)
+    q = ik_tcp(T, dims.UR5_READY_Q)[0]
+    xs, zs = np.meshgrid(np.arange(-0.04, 0.041, 0.005), np.arange(0.0, 0.04, 0.005))
+
+    def face(y: float) -> np.ndarray:  # a vertical sheet along the hand axis, in `base`
+        local = np.c_[xs.ravel(), np.full(xs.size, y), -zs.ravel()]
+        return local @ T[:3, :3].T + T[:3, 3]
+
+    for y, planned in ((0.01, True), (0.05, False)):
+        pts = np.vstack([table(top), face(y)])
+        pts = pts[pts[:, 2] >= top - 1e-9]
+        world = CollisionChecker(pts)
+        plan = plan_pick(dims.UR5_READY_Q, q, world, world, np.random.default_rng(0))
+        if planned:
+            assert not isinstance(plan, Failure), plan
+        else:
+            assert isinstance(plan, Failure) and "hit something beside" in plan.message
+
+
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_checker_ignores_non_finite_points(bad):
     pts = np.array([[1.5, -0.3, bad], [5.0, 5.0, 5.0]])

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from laserpick.description import dims
+from laserpick.description.collision import GRIPPER_CAPSULES
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.reach import pregrasp_pose
@@ -35,6 +36,8 @@ CARTESIAN_JUMP = 0.25
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
 HAND_CONTACT_TOLERANCE = 0.004
+#: The gripper housing's capsule radius (m), the first of `GRIPPER_CAPSULES`.
+HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
 
 
 def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
@@ -257,6 +260,23 @@ def straight_lift(
     return None
 
 
+def between_the_fingers(points: np.ndarray, T_grasp: np.ndarray) -> np.ndarray:
+    """(N,) mask of `points` (m, `base`) in the open gripper's closing region at the TCP
+    pose T_grasp: between the fingers' inner faces (across the stroke), from the finger
+    roots to the tips, as far along the hand axis as the housing's capsule reaches."""
+    if len(points) == 0:
+        return np.zeros(0, bool)
+    local = (points - T_grasp[:3, 3]) @ T_grasp[:3, :3]
+    tip = dims.GRIPPER_PAD_DEPTH / 2  # the TCP is midway along the pads, behind the tips
+    root = tip - dims.GRIPPER_FINGER_LENGTH
+    return (
+        (np.abs(local[:, 0]) <= HOUSING_RADIUS)
+        & (np.abs(local[:, 1]) < dims.GRIPPER_STROKE / 2)
+        & (local[:, 2] >= root)
+        & (local[:, 2] <= tip)
+    )
+
+
 def plan_pick(
     q_now: np.ndarray,
     q_grasp: np.ndarray,
@@ -292,12 +312,17 @@ def plan_pick(
     """
     s = settings or get_settings().motion
     searches = searches or Searches(s.rrt_max_failed)
-    if (
-        check_hand
-        and not surroundings.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]
-    ):
-        return Failure("ik_plan", "The hand would hit something beside the object.")
     T_grasp = tcp_pose(q_grasp)
+    if check_hand:
+        # What stands between the open fingers is what they close on: parts of the object
+        # the segmentation left out (a tissue packet's side face). The housing's spheres
+        # reach down between the fingers, where the real housing does not.
+        pts = surroundings.points
+        beside = CollisionChecker(
+            pts[~between_the_fingers(pts, T_grasp)], margin=surroundings.margin, filtered=True
+        )
+        if not beside.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]:
+            return Failure("ik_plan", "The hand would hit something beside the object.")
     pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
     if len(pre) == 0:
         return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
