@@ -623,7 +623,7 @@ class Behaviours:
         if failure is not None:
             return Outcome(failure)
         # Around the object as it was let go, else as it fell, lower (no way around it). To
-        # ready; parked at a shelf or a high table, whose boards fill both ready poses (11 of
+        # ready; parked at a shelf or a high table, whose boards fill both ready poses (10 of
         # 67 in-situ attempts once ended there, the object in the basket), folded away from
         # the basket instead, as the session's stow would do next.
         for leave in (self.go_ready, self._fold_away):

@@ -135,7 +135,7 @@ def test_with_both_ready_poses_filled_the_arm_stows_by_a_search(robot):
 
 def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket(robot):
     """Parked at a shelf, whose boards fill both ready poses, the arm that has let go over
-    the basket folds away from there (11 of 67 in-situ attempts once ended with the object
+    the basket folds away from there (10 of 67 in-situ attempts once ended with the object
     in the basket and no way to ready)."""
     name = "mug_1"
     b, referee = _pick(robot, name)
