@@ -767,10 +767,7 @@ class Behaviours:
         if len(pts) == 0 or len(target) == 0:
             return surroundings
         d, _ = cKDTree(target).query(pts, distance_upper_bound=CARRIED_PADDING)
-        leftover = np.isfinite(d) & (pts[:, 2] > support + CARRIED_PADDING)
-        if not leftover.any():
-            return surroundings
-        return CollisionChecker(pts[~leftover], margin=surroundings.margin, filtered=True)
+        return surroundings.without(np.isfinite(d) & (pts[:, 2] > support + CARRIED_PADDING))
 
     @staticmethod
     def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:

@@ -407,6 +407,17 @@ class CollisionChecker:
         out._own = _OwnSpace(np.vstack([own.centres, centres]), np.append(own.reach, reach))
         return out
 
+    def without(self, drop: np.ndarray) -> CollisionChecker:
+        """This checker less its points where the mask `drop` (N,) is set (what is known to
+        be no obstacle: parts of the target the segmentation left out); the same margin and
+        seen space. Returned as it is when nothing is dropped."""
+        if not drop.any():
+            return self
+        out = copy.copy(self)
+        out.points = self.points[~drop]
+        out.tree = cKDTree(out.points) if len(out.points) else None
+        return out
+
     def unseen(self, centres: np.ndarray, radius: np.ndarray) -> np.ndarray:
         """(N,) whether each sphere (centres (N, 3), `base`, m; radius (N,) m) reaches into
         space no camera saw, tested at its centre and the six points of its surface along

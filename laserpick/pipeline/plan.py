@@ -317,10 +317,7 @@ def plan_pick(
         # What stands between the open fingers is what they close on: parts of the object
         # the segmentation left out (a tissue packet's side face). The housing's spheres
         # reach down between the fingers, where the real housing does not.
-        pts = surroundings.points
-        beside = CollisionChecker(
-            pts[~between_the_fingers(pts, T_grasp)], margin=surroundings.margin, filtered=True
-        )
+        beside = surroundings.without(between_the_fingers(surroundings.points, T_grasp))
         if not beside.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]:
             return Failure("ik_plan", "The hand would hit something beside the object.")
     pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
