@@ -374,19 +374,24 @@ class Behaviours:
                 self.robot.sleep(GRIPPER_TIME)
                 self.held = None
             return Outcome(failure, grasp, attempts, timings)
-        failure = self._withdraw(self.held)
+        failure = self._withdraw(grasp.approach, around, pts_tcp)
         if failure:  # the hand keeps what it holds: the session tucks it in
             return Outcome(failure, grasp, attempts, timings)
         self.progress("Holding the object.")
         return Outcome(None, grasp, attempts, timings)
 
-    def _withdraw(self, held: Held) -> Failure | None:
-        """After a grasp from the side, draw the lifted hand straight back out along its
-        approach, level, by `approach_distance` (or half that where the whole is not clear):
-        out of a shelf's gap before the arm swings anywhere. A swing planned from inside the
-        69 cm shelf found no way out, or met the board above. A grasp from above (within
-        WITHDRAW_STEEP of the vertical) has risen out already."""
-        approach = held.grasp.pose[:3, 2]
+    def _withdraw(
+        self,
+        approach: np.ndarray,
+        checker: CollisionChecker,
+        payload: np.ndarray | None = None,
+    ) -> Failure | None:
+        """After a grasp from the side, draw the hand straight back out along its `approach`
+        (unit, `base`), level, by `approach_distance` (or half that where the whole is not
+        clear of `checker`, with `payload` in the hand): after a lift, out of a shelf's gap
+        before the arm swings anywhere (a swing planned from inside the 69 cm shelf found
+        no way out, or met the board above); after a place, off the object it let go of.
+        A grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising."""
         level = np.hypot(*approach[:2])
         if level < np.sin(WITHDRAW_STEEP):
             return None
@@ -398,10 +403,7 @@ class Behaviours:
             T = here.copy()
             T[:3, 3] += distance * back
             path = cartesian_line(q, T, s.cartesian_step)
-            if (
-                path is None
-                or not held.surroundings.clearance_ok(path, payload=held.points_tcp).all()
-            ):
+            if path is None or not checker.clearance_ok(path, payload=payload).all():
                 continue
             return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
         return None
@@ -641,8 +643,9 @@ class Behaviours:
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
-        hand opens and rises straight back, and the arm stows around the object where it
-        now stands. Nothing felt by `place_below` under the rest: the hand keeps it.
+        hand opens and leaves it (drawn back along its approach from the side, else
+        straight up), and the arm stows around the object where it now stands. Nothing felt
+        by `place_below` under the rest: the hand keeps it.
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -690,7 +693,9 @@ class Behaviours:
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
         T_release = tcp_pose(self._q())
-        self._rise_straight(T_above, "rising from the object")
+        failure = self._leave_placed(T_above, checker)
+        if failure is not None:
+            return Outcome(failure, held.grasp, spot=spot)
         # Stowed around the object where it now stands: the unchecked moves of a stow swept
         # the hand through it from the 87 cm counter (4 of 39 pick-place tasks ended with
         # the object pushed 12-20 cm away or off the counter).
@@ -710,6 +715,19 @@ class Behaviours:
             return Outcome(failure, held.grasp, spot=spot)
         self.progress("Placed.")
         return Outcome(None, held.grasp, spot=spot)
+
+    def _leave_placed(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
+        """Take the open hand off what it has just set down: drawn back along its approach,
+        level, if it holds from the side and that way is clear of `checker` (which leaves
+        the object out: the fingers start about it), else straight up to the TCP pose
+        T_above (4, 4, `base`), the way it came down. Risen straight up from the side, the
+        hand stayed about a tall box's top (a cereal box that had slid 3.6 cm down in the
+        pads stood 1 cm above the fingers), and no way to ready was found."""
+        start = tcp_pose(self._q())
+        failure = self._withdraw(start[:3, 2], checker)
+        if failure is None and np.linalg.norm(tcp_pose(self._q())[:3, 3] - start[:3, 3]) < 0.01:
+            self._rise_straight(T_above, "rising from the object")  # not drawn back
+        return failure
 
     def _rise_straight(self, T: np.ndarray, what: str) -> None:
         """Rise in a straight line to TCP pose T (4, 4, `base`) at the approach speed, if the

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from laserpick.behaviours import PLACE_YAWS, Behaviours, Held, drop_candidates, turned_hand_xy
+from laserpick.behaviours import PLACE_YAWS, Behaviours, drop_candidates, turned_hand_xy
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
 from laserpick.bench.truth import Captured
@@ -533,6 +533,17 @@ def _side_pose(x: float, y: float, z: float) -> np.ndarray:
     return T
 
 
+def _post_behind(q_side: np.ndarray, payload: np.ndarray | None = None) -> CollisionChecker:
+    """A post behind the hand at `_side_pose(1.70, -0.30, 0.80)` (joint angles q_side),
+    clear of it where it stands but in the way of 5 cm back."""
+    half = cartesian_line(q_side, _side_pose(1.65, -0.30, 0.80))
+    for x in np.arange(1.55, 1.2, -0.01):
+        post = CollisionChecker(np.array([[x, -0.30, z] for z in np.arange(0.6, 1.0, 0.01)]))
+        if post.clearance_ok(q_side, payload=payload)[0] and not post.clearance_ok(half).all():
+            return post
+    pytest.fail("no post position blocks the way back but not the hand")
+
+
 def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
     """Out of a shelf's gap before the arm swings anywhere: the lifted hand goes straight
     back along its approach, level, 10 cm; not where a post stands in the way (the arm
@@ -544,23 +555,42 @@ def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
     q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
     assert b.go_to(q_side, free, "test").ok
     payload = np.zeros((1, 3))
-    held = Held(Grasp(pose=side, width=0.05), 0.05, payload, free)
-    assert b._withdraw(held) is None
+    assert b._withdraw(side[:3, 2], free, payload) is None
     np.testing.assert_allclose(
         tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
     )
-    # A post behind the hand, clear of it where it stands but in the way of 5 cm back.
     assert b.go_to(q_side, free, "test").ok
-    for x in np.arange(1.55, 1.2, -0.01):
-        post = CollisionChecker(np.array([[x, -0.30, z] for z in np.arange(0.6, 1.0, 0.01)]))
-        half = cartesian_line(q_side, _side_pose(1.65, -0.30, 0.80))
-        if post.clearance_ok(q_side, payload=payload)[0] and not post.clearance_ok(half).all():
-            break
-    else:
-        pytest.fail("no post position blocks the way back but not the hand")
+    post = _post_behind(q_side, payload)
     stood = robot.joint_state().q
-    assert b._withdraw(Held(held.grasp, 0.05, payload, post)) is None
+    assert b._withdraw(side[:3, 2], post, payload) is None
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
-    top = Held(Grasp(pose=_top_down(1.6, -0.3, 0.8), width=0.05), 0.05, payload, free)
-    assert b._withdraw(top) is None
+    assert b._withdraw(_top_down(1.6, -0.3, 0.8)[:3, 2], free, payload) is None
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
+
+
+def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
+    """From the side, drawn back off the object, level: straight up, the fingers stayed
+    about a tall box's top. From above, or where the way back is not clear, straight up
+    to the pose above the place, the way it came down."""
+    b = Behaviours(robot)
+    free = CollisionChecker(np.zeros((0, 3)))
+    side = _side_pose(1.70, -0.30, 0.80)
+    above = side.copy()
+    above[2, 3] += 0.10
+    q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
+    assert b.go_to(q_side, free, "test").ok
+    assert b._leave_placed(above, free) is None
+    np.testing.assert_allclose(
+        tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
+    )
+    # Where the way back is not clear: up instead.
+    assert b.go_to(q_side, free, "test").ok
+    assert b._leave_placed(above, _post_behind(q_side)) is None
+    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
+    top = _top_down(1.6, -0.3, 0.8)
+    top_above = top.copy()
+    top_above[2, 3] += 0.10
+    q_top = next(q for q in ik_tcp(top, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
+    assert b.go_to(q_top, free, "test").ok
+    assert b._leave_placed(top_above, free) is None
+    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], top_above[:3, 3], atol=0.005)
