@@ -285,6 +285,23 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     assert up[2] > np.cos(np.radians(15)), "it should stand as it stood"
 
 
+def test_what_the_cameras_see_now_has_the_objects_and_not_the_arm(robot):
+    """After a place the arm stows around what the cameras see then: the object where it
+    really stands (it may have slid in the pads), not the arm's own points, which would
+    leave the planner no clear start."""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    q = robot.joint_state().q
+    seen = b._seen_now()
+    referee = Referee(robot)
+    mug = referee.object_points("mug_1")
+    near = np.linalg.norm(seen[:, None, :] - mug[None, ::20, :], axis=2).min(axis=0)
+    assert np.mean(near < 0.02) > 0.25, "the side of the mug the cameras face is there"
+    assert CollisionChecker(seen, filtered=True).clearance_ok(q)[0]
+    raw = fuse(robot.capture()).points
+    assert not CollisionChecker(raw).clearance_ok(q)[0], "the arm is in the raw capture"
+
+
 def test_a_turned_placement_turns_the_object_about_its_middle():
     """An object held 7 cm off its middle, set down turned, stands where it would unturned:
     turned about the hand, it would land up to 14 cm away."""
