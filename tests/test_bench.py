@@ -37,6 +37,7 @@ from laserpick.bench.protocols import (
     UPRIGHT_TILT,
     Options,
     _operated,
+    _spot_in_sight,
     _still_there,
     coin_flip_kitchen,
     jeeves_scene,
@@ -380,6 +381,33 @@ def test_a_can_that_rolls_on_its_side_is_not_tipped_but_one_stood_up_is():
     raised = quat_from_matrix(rotx(math.pi / 2 - math.radians(20)))  # axis 20 deg up
     assert placed_tilt(can, before, raised) == pytest.approx(math.radians(20))
     assert placed_tilt(can, before, quat_from_matrix(np.eye(3))) == pytest.approx(math.pi / 2)
+
+
+def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
+    tmp_path: Path,
+) -> None:
+    """A person watches the dot before confirming a place mark: where a box between the seat
+    and the spot takes it, they move the aim aside until the dot lies on the free table."""
+    scene = tmp_path / "box.yaml"
+    scene.write_text(
+        "name: box\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: t, kind: table, xy: [1.6, -0.2], size: [0.6, 1.0], height: 0.46}\n"
+        "objects:\n  - {name: box, model: cereal_box, on: t, xy: [1.40, 0.12], yaw_deg: 90}\n"
+    )
+    loaded = load_scene(str(scene))
+    with _operated(loaded, 0, 1, Options(tremor_deg=0.0)) as op:
+        table = loaded.surface("t")
+        hidden = np.array([1.65, 0.12, 0.46])  # 25 cm behind the box, seen from the seat
+        op.aim(op.referee.to_base(hidden))
+        assert op.referee.dot_on("box"), "the box hides the spot"
+        target = _spot_in_sight(op, table, hidden)
+        assert np.linalg.norm(target - op.referee.to_base(hidden)) > 0.04
+        op.aim(target)
+        assert not op.referee.dot_on("box")
+        assert np.linalg.norm(op.referee.to_base(op.robot.laser_hits()[0]) - target) < 0.03
+        in_sight = np.array([1.65, -0.40, 0.46])
+        target = _spot_in_sight(op, table, in_sight)
+        assert np.allclose(target, op.referee.to_base(in_sight))
 
 
 def test_a_pick_place_task_is_tried_again_while_its_object_stands_where_it_stood(

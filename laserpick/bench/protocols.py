@@ -88,6 +88,13 @@ FLOOR_TURNS = tuple(math.radians(a) for a in (0, 45, -45, 90, -90, 135, -135, 18
 #: stood before, and as on target within this distance (m) of the mark plus its offset.
 UPRIGHT_TILT = math.radians(15.0)
 PLACE_TOLERANCE = 0.03
+#: Where the dot of a place mark lands on something in front of the spot (an object between
+#: the seat and it), the user moves the aim by these (m, the surface's x back and y across)
+#: until the dot lies within DOT_ON_SPOT (m) of where they aim, as a person who watches
+#: the dot does; three marks on the side of a box in front of the spot were refused ("not
+#: on a flat surface") and the task was lost.
+AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), (0.05, 0.0))
+DOT_ON_SPOT = 0.03
 #: The laser-scan protocol's step between aim points (m), 002's "about 1.5 cm".
 SCAN_STEP = 0.015
 #: The models of the two-object selection trials: the `isolation` set less the tall cereal
@@ -420,15 +427,39 @@ def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray
     boards: under a board the cameras see no dot and no surface. None when the surface has
     no such spot."""
     half_w = surface.size[1] / 2 - 0.15
-    objects = [op.referee.world_position(n) for n in op.referee.instances()]
     level = surface.levels[-1]
     depth = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
     for _ in range(100):
         ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
         xy = surface.to_world(np.array([-surface.size[0] / 2 + depth, ly]))
-        if all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1):
+        if _free(op, xy, level):
             return ly, np.array([xy[0], xy[1], level])
     return None
+
+
+def _free(op: ScriptedOperator, xy: np.ndarray, level: float) -> bool:
+    """Whether the spot `xy` (m, `world`) at height `level` is 15 cm from every object."""
+    objects = [op.referee.world_position(n) for n in op.referee.instances()]
+    return all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1)
+
+
+def _spot_in_sight(op: ScriptedOperator, surface: Surface, spot: np.ndarray) -> np.ndarray:
+    """Where the user marks to put something at `spot` (m, `world`, on `surface`'s top):
+    the spot itself, or, where the dot lands on something in front of it, the first aim of
+    AIM_SHIFTS that is free, on the surface and lit by the dot (`base`, m)."""
+    half = np.asarray(surface.size[:2]) / 2
+    local = surface.to_local(spot[:2])
+    for dx, dy in AIM_SHIFTS:
+        moved = local + (dx, dy)
+        xy = surface.to_world(moved)
+        if np.any(np.abs(moved) > half - 0.05) or not _free(op, xy, spot[2]):
+            continue
+        target = op.referee.to_base(np.array([xy[0], xy[1], spot[2]]))
+        op.aim(target)
+        hits = op.robot.laser_hits()
+        if hits and np.linalg.norm(op.referee.to_base(hits[0]) - target) < DOT_ON_SPOT:
+            return target
+    return op.referee.to_base(spot)
 
 
 def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
@@ -523,7 +554,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         failure = Failure("precondition", f"the user could not park at {dest.name}")
     else:
         return rec.fail(failure.kind, failure.message)
-    spot_base = referee.to_base(spot_world)
+    spot_base = _spot_in_sight(op, dest, spot_world)
     for _ in range(MAX_TRIES):  # the user marks again while the hand still holds it
         placed = op.place(spot_base)
         rec.places += 1
