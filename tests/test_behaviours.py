@@ -585,29 +585,32 @@ def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
 
 
+def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Move the arm to TCP pose `pose` (4, 4, `base`); its joint angles and the pose 10 cm
+    above it."""
+    free = CollisionChecker(np.zeros((0, 3)))
+    q = next(q for q in ik_tcp(pose, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
+    assert b.go_to(q, free, "test").ok
+    above = pose.copy()
+    above[2, 3] += 0.10
+    return q, above
+
+
 def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
     """From the side, drawn back off the object, level: straight up, the fingers stayed
     about a tall box's top. From above, or where the way back is not clear, straight up
     to the pose above the place, the way it came down."""
     b = Behaviours(robot)
     free = CollisionChecker(np.zeros((0, 3)))
-    side = _side_pose(1.70, -0.30, 0.80)
-    above = side.copy()
-    above[2, 3] += 0.10
-    q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
-    assert b.go_to(q_side, free, "test").ok
+    q_side, above = _hand_at(b, _side_pose(1.70, -0.30, 0.80))
     assert b._leave_placed(above, free) is None
     np.testing.assert_allclose(
         tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
     )
     # Where the way back is not clear: up instead.
-    assert b.go_to(q_side, free, "test").ok
+    _hand_at(b, _side_pose(1.70, -0.30, 0.80))
     assert b._leave_placed(above, _post_behind(q_side)) is None
     np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
-    top = _top_down(1.6, -0.3, 0.8)
-    top_above = top.copy()
-    top_above[2, 3] += 0.10
-    q_top = next(q for q in ik_tcp(top, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
-    assert b.go_to(q_top, free, "test").ok
-    assert b._leave_placed(top_above, free) is None
-    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], top_above[:3, 3], atol=0.005)
+    _, above = _hand_at(b, _top_down(1.6, -0.3, 0.8))
+    assert b._leave_placed(above, free) is None
+    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
