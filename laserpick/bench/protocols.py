@@ -429,17 +429,23 @@ def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray
     half_w = surface.size[1] / 2 - 0.15
     level = surface.levels[-1]
     depth = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
+    objects = _objects(op)
     for _ in range(100):
         ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
         xy = surface.to_world(np.array([-surface.size[0] / 2 + depth, ly]))
-        if _free(op, xy, level):
+        if _free(objects, xy, level):
             return ly, np.array([xy[0], xy[1], level])
     return None
 
 
-def _free(op: ScriptedOperator, xy: np.ndarray, level: float) -> bool:
-    """Whether the spot `xy` (m, `world`) at height `level` is 15 cm from every object."""
-    objects = [op.referee.world_position(n) for n in op.referee.instances()]
+def _objects(op: ScriptedOperator) -> list[np.ndarray]:
+    """Where every object stands now (m, `world`)."""
+    return [op.referee.world_position(n) for n in op.referee.instances()]
+
+
+def _free(objects: list[np.ndarray], xy: np.ndarray, level: float) -> bool:
+    """Whether the spot `xy` (m, `world`) at height `level` is 15 cm from every one of
+    `objects` (m, `world`) at about that height."""
     return all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1)
 
 
@@ -449,10 +455,11 @@ def _spot_in_sight(op: ScriptedOperator, surface: Surface, spot: np.ndarray) -> 
     AIM_SHIFTS that is free, on the surface and lit by the dot (`base`, m)."""
     half = np.asarray(surface.size[:2]) / 2
     local = surface.to_local(spot[:2])
+    objects = _objects(op)
     for dx, dy in AIM_SHIFTS:
         moved = local + (dx, dy)
         xy = surface.to_world(moved)
-        if np.any(np.abs(moved) > half - 0.05) or not _free(op, xy, spot[2]):
+        if np.any(np.abs(moved) > half - 0.05) or not _free(objects, xy, spot[2]):
             continue
         target = op.referee.to_base(np.array([xy[0], xy[1], spot[2]]))
         op.aim(target)
