@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from laserpick.pipeline.cloud import ray_hit
+from laserpick.pipeline.cloud import ray_distance, ray_hit
 
 
 def _wall_and_box() -> np.ndarray:
@@ -36,3 +36,12 @@ def test_a_ray_that_misses_or_points_away_finds_nothing() -> None:
 def test_a_zero_direction_is_refused() -> None:
     with pytest.raises(ValueError, match="direction"):
         ray_hit(_wall_and_box(), np.zeros(3), np.zeros(3))
+
+
+def test_how_far_a_point_lies_from_a_ray() -> None:
+    o, d = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 2.0])  # up the z axis from x = 1
+    assert ray_distance(np.array([1.0, 0.0, 5.0]), o, d) == pytest.approx(0.0)
+    assert ray_distance(np.array([1.0, 0.3, 5.0]), o, d) == pytest.approx(0.3)
+    assert ray_distance(np.array([1.0, 0.0, -0.4]), o, d) == pytest.approx(0.4)  # behind
+    with pytest.raises(ValueError, match="direction"):
+        ray_distance(np.zeros(3), o, np.zeros(3))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -48,9 +49,9 @@ def _wait(predicate, timeout: float = 30.0) -> None:
 
 def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> None:
     """A click aims and the session works the mark out at once; the 3D view sends its
-    highlight ahead, hidden. The confirm at that point takes that very perception and
-    shows that very node. A confirm elsewhere, or after the scooter moved, works the mark
-    out anew."""
+    highlight ahead, hidden. The confirm at that point lights it at once, takes that very
+    perception and shows that very node. A confirm elsewhere, or after the scooter moved,
+    works the mark out anew."""
     import viser
 
     from laserpick.console.operator_console import OperatorConsole
@@ -76,6 +77,7 @@ def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> 
         assert not ahead.visible
         foreseen = session._foreseen
         session.confirm(actor, point=centre[0])
+        assert session.projection is image  # lit by the confirm itself, before the job runs
         _wait(lambda: not session.busy and session.state != TaskState.MARKED)
         assert session.task.perception is foreseen.perception
         assert session.projection is image
@@ -89,6 +91,7 @@ def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> 
         _wait(lambda: session.foreseen is not None)
         assert session._foreseen is foreseen
         session.confirm(actor, point=centre[1])
+        assert session.projection is None  # not foreseen: lit once the job has worked it out
         _wait(lambda: not session.busy and session.state != TaskState.MARKED)
         assert session.task.perception is not foreseen.perception
         assert session.task.perception.cloud is foreseen.perception.cloud
@@ -124,3 +127,50 @@ def test_a_drive_that_overtakes_the_stop_sent_after_it_is_dropped() -> None:
         assert session._drive_seq == (actor.token, 9)
     finally:
         session.close()
+
+
+def test_a_second_click_on_the_dot_confirms_though_a_new_capture_sees_otherwise() -> None:
+    """The second click confirms when its ray passes through the aimed point, whatever the
+    cloud now says: here the object is taken away and the capture goes stale between the two
+    clicks, so the same ray would now meet the table behind. A click elsewhere aims anew."""
+    from types import SimpleNamespace
+
+    import viser
+
+    from laserpick.console.operator_console import OperatorConsole, to_world
+
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    console = OperatorConsole(session, server)
+    try:
+        session.lease.acquire("test", "console")  # the view acts as the console station
+        referee = Referee(session.robot)
+        name = referee.instances()[0]
+        pts = referee.object_points(name)
+        centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+        centre[2] = pts[:, 2].max() - 0.01  # on its top, as a camera above sees it
+        origin = to_world(np.array([0.2, 0.0, 1.6]), session.robot.base_pose())
+
+        def click(at_base: np.ndarray) -> None:
+            direction = to_world(at_base, session.robot.base_pose()) - origin
+            event = SimpleNamespace(ray_origin=origin, ray_direction=direction, client=None)
+            console._clicked(event)
+
+        click(centre)
+        assert session.state == TaskState.AIMING
+        aimed = console._aimed_at
+        assert aimed is not None and np.linalg.norm(aimed - centre) < 0.03
+        click(aimed + np.array([0.0, 0.2, 0.0]))  # elsewhere: a new aim, not a confirm
+        assert session.state == TaskState.AIMING and not session.busy
+        assert np.linalg.norm(console._aimed_at - aimed) > 0.1
+        click(centre)
+        aimed = console._aimed_at
+        referee.take_out(name)
+        session._capture = dataclasses.replace(session._capture, at=time.monotonic() - 60.0)
+        click(aimed)
+        assert session.robot.laser.state.confirmed or session.state != TaskState.AIMING
+        assert console._aimed_at is None
+    finally:
+        console.stop()
+        session.close()
+        server.stop()

@@ -37,7 +37,7 @@ import numpy as np
 import viser
 
 from laserpick.description import dims
-from laserpick.pipeline.cloud import voxel_first
+from laserpick.pipeline.cloud import ray_distance, voxel_first
 from laserpick.pipeline.projector import Projector
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.types import FusedCloud, Grasp
@@ -205,23 +205,31 @@ class OperatorConsole:
             return False
 
     def _clicked(self, event: viser.SceneClickEvent) -> None:
-        """Aim where the click's ray meets the cloud; a second click near the aimed point
-        confirms the mark there (or the place mark), as the laser points: the session has
-        worked that mark out since the first click."""
+        """Aim where the click's ray meets the cloud; a second click on the aimed point (its
+        ray passes within CONFIRM_RADIUS of it) confirms the mark there (or the place mark),
+        as the laser points: the session has worked that mark out since the first click.
+        The confirm does not look for the ray's hit again: a capture refreshed between the
+        two clicks would put it elsewhere, and the dot is where the user clicked."""
         session = self.session
         origin = np.asarray(event.ray_origin, dtype=float)
         direction = np.asarray(event.ray_direction, dtype=float)
         before = self._aimed_at if session.state in CONFIRMABLE else None
-        hit: list[np.ndarray] = []
-        if not self.act(
-            event.client, lambda a: hit.append(session.ray_point(origin, direction, "world"))
+        if before is not None and (
+            ray_distance(to_world(before, session.robot.base_pose()), origin, direction)
+            < CONFIRM_RADIUS
         ):
-            return
-        if before is not None and np.linalg.norm(hit[0] - before) < CONFIRM_RADIUS:
             self._aimed_at = None
             self._confirmed_at = time.monotonic()
-            self.act(event.client, lambda a: session.confirm(a, point=before))
-        elif self.act(event.client, lambda a: session.aim_at(a, hit[0], "base", foresee=True)):
+            if self.act(event.client, lambda a: session.confirm(a, point=before)):
+                # The confirm lit the target it foresaw: show it from here, not after the
+                # refresh loop's next turn, which the starting job slows (GIL).
+                with self._lock:
+                    self._draw_cloud()
+            return
+        hit: list[np.ndarray] = []
+        if self.act(
+            event.client, lambda a: hit.append(session.ray_point(origin, direction, "world"))
+        ) and self.act(event.client, lambda a: session.aim_at(a, hit[0], "base", foresee=True)):
             self._aimed_at = hit[0]
 
     # --- the panel -------------------------------------------------------------------------

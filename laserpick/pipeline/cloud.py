@@ -172,6 +172,23 @@ def voxel_downsample(cloud: FusedCloud, size: float) -> FusedCloud:
     return cloud.subset(voxel_first(cloud.points, size))
 
 
+def _unit(direction: np.ndarray) -> np.ndarray:
+    d = np.asarray(direction, dtype=np.float64)
+    norm = float(np.linalg.norm(d))
+    if not np.isfinite(norm) or norm == 0.0:
+        raise ValueError("the ray's direction must be a finite, non-zero vector")
+    return d / norm
+
+
+def ray_distance(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> float:
+    """How far (m) `point` (3,) lies from the ray from `origin` (3,) along `direction` (3,):
+    from the line ahead of the origin, or from the origin for a point behind it. A second
+    click on the laser's dot passes through the aimed point. All in one frame."""
+    rel = np.asarray(point, dtype=np.float64) - np.asarray(origin, dtype=np.float64)
+    along = max(float(rel @ _unit(direction)), 0.0)
+    return float(np.linalg.norm(rel - along * _unit(direction)))
+
+
 def ray_hit(
     points: np.ndarray, origin: np.ndarray, direction: np.ndarray, radius: float = 0.01
 ) -> np.ndarray | None:
@@ -179,11 +196,7 @@ def ray_hit(
     from `origin` (3,) along `direction` (3,), the one nearest the origin along the ray, as
     a (3,) float64 point; None if the ray passes every point. A click in the 3D view gives a
     ray; this turns it into the point the user meant. All in one frame (e.g. `base`)."""
-    d = np.asarray(direction, dtype=np.float64)
-    norm = float(np.linalg.norm(d))
-    if not np.isfinite(norm) or norm == 0.0:
-        raise ValueError("the ray's direction must be a finite, non-zero vector")
-    d /= norm
+    d = _unit(direction)
     rel = np.asarray(points, dtype=np.float64) - np.asarray(origin, dtype=np.float64)
     along = rel @ d
     off2 = np.einsum("ij,ij->i", rel, rel) - along**2

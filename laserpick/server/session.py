@@ -500,6 +500,16 @@ class Session:
                 if self.strategy == "jeeves":
                     self._require_motion(actor, "laser/confirm")
                 self._set(TaskState.MARKED, "Marked. Looking at the object.")
+                seen = self._foreseen
+                if (
+                    point is not None
+                    and seen is not None
+                    and seen.capture is self._capture
+                    and np.array_equal(seen.point, point)
+                ):
+                    # Worked out since the aim, and the job will take this same result:
+                    # the projector lights the target now, not after the job's first step.
+                    self._projection = seen.lit
                 job = self._perceive_job if point is None else lambda: self._perceive_job(point)
                 self._start(actor, "perceiving", job, motion=self.strategy == "jeeves")
 
@@ -800,9 +810,11 @@ class Session:
             if self._cancel.is_set():
                 self.robot.laser.off()
                 self.task = _Task()
+                self._projection = None
                 self._set(TaskState.IDLE, "Cancelled.")
                 return
             if perception.failure is not None:
+                self._projection = None
                 yaw, pitch = self.robot.laser.state.yaw, self.robot.laser.state.pitch
                 self.robot.laser.aim(yaw, pitch)  # back to the single aiming beam
                 self._fail(perception.failure, TaskState.AIMING)
