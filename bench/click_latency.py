@@ -91,7 +91,7 @@ def open_view(browser: Any, server: ServeProcess, detail: str, probe: str) -> tu
     page.add_init_script(probe + detail_setting(detail))
     page.goto(server.url)
     page.frame_locator("iframe#view").get_by_role("button", name="Detect").wait_for(timeout=30_000)
-    frame = next(f for f in page.frames if f.url.startswith(server.viser_url))
+    frame = page.locator("iframe#view").element_handle().content_frame()
     time.sleep(6.0)  # the scene fades in
     return page, frame
 

@@ -21,6 +21,7 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from urllib.parse import parse_qs, urlsplit
 
 import pytest
 from basket import judge_drop, lost_in_carry
@@ -239,13 +240,32 @@ def wait_rendered(page) -> None:
     time.sleep(3.0)
 
 
+def view_src(frame) -> tuple[str, str | None, str | None]:
+    """The 3D view iframe's address: its path, and its fixedDpr and multisample settings."""
+    src = urlsplit(frame.get_attribute("src"))
+    query = parse_qs(src.query)
+    return src.path, *(query.get(k, [None])[0] for k in ("fixedDpr", "multisample"))
+
+
 def _renders(page, server: ServeProcess) -> None:
     frame = page.locator("iframe#view")
     assert frame.get_attribute("title"), "the 3D view's iframe needs a title"
-    # This browser draws WebGL without a GPU: "auto" detail is half (a quarter of the pixels).
-    assert frame.get_attribute("src") == server.viser_url + "/?fixedDpr=0.5"
+    # This browser draws WebGL without a GPU: "auto" detail is half (a quarter of the pixels,
+    # no multisampling), in our copy of viser's page, connected to the viser server.
+    assert view_src(frame) == ("/view", "0.5", "0")
+    assert parse_qs(urlsplit(frame.get_attribute("src")).query)["websocket"] == [
+        "ws" + server.viser_url.removeprefix("http") + "/"
+    ]
     assert "without a GPU" in page.locator("#view-detail-note").text_content()
     wait_rendered(page)
+    assert (
+        frame.element_handle()
+        .content_frame()
+        .evaluate(
+            "document.querySelector('canvas').getContext('webgl2').getContextAttributes().antialias"
+        )
+        is False
+    )
     ARTIFACTS.mkdir(exist_ok=True)
     page.screenshot(path=str(ARTIFACTS / "page.png"))
 
@@ -274,7 +294,7 @@ def _renders(page, server: ServeProcess) -> None:
     # Full detail on request, remembered: the view reloads without the half-detail setting.
     page.locator("#settings > summary").click()
     page.get_by_label("3D view detail").select_option("full")
-    assert frame.get_attribute("src") == server.viser_url + "/"
+    assert view_src(frame) == ("/view", None, None)
     assert '"viewDetail":"full"' in page.evaluate(
         "localStorage.getItem('laserpick.settings.operator')"
     )

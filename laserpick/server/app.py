@@ -36,6 +36,7 @@ from starlette.websockets import WebSocketDisconnect
 
 from laserpick import __version__
 from laserpick.bench.operator import Referee
+from laserpick.console.view_page import view_page
 from laserpick.pipeline.cloud import voxel_downsample
 from laserpick.robot.scenes import SceneError, load_scene, parse_scene
 from laserpick.server import schemas as S
@@ -285,10 +286,15 @@ def create_app(
             text = page()
         else:
             text = html.read_text(encoding="utf-8") if html.is_file() else _MINIMAL_PAGE
-        # Its own agent cluster, so Chromium gives the page a process of its own: the 3D
-        # view it embeds (another port, the same site) then cannot hold up its script. With
-        # software WebGL that took the page's frame age from about 2 s to under 50 ms.
-        return HTMLResponse(text, headers={"Origin-Agent-Cluster": "?1"})
+        return HTMLResponse(text)
+
+    @app.get("/view", response_class=HTMLResponse, include_in_schema=False)
+    def view() -> HTMLResponse:
+        """The 3D view's page, which the page at `/` embeds (console/view_page.py)."""
+        try:
+            return HTMLResponse(view_page())
+        except RuntimeError as exc:
+            raise HTTPException(503, str(exc)) from exc
 
     if STATIC.is_dir():
         app.mount("/static", StaticFiles(directory=STATIC), name="static")

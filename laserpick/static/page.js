@@ -854,14 +854,20 @@ const softwareGL = (() => {
   } catch { return null; }
 })();
 
-// The 3D view's address with its detail: "half" draws a quarter of the pixels. Without a GPU
-// a full-detail frame takes 70-85 ms, and while the scene changes the browser spends most of
-// the robot computer's CPU drawing (bench/view_load.py), so "auto" is half there and full
-// elsewhere.
+// The 3D view's address with its detail: our copy of viser's client page (at "view"),
+// connected to the viser server at viewUrl. "half" draws a quarter of the pixels, without
+// multisampling. Without a GPU a full-detail frame takes 70-85 ms, and while the scene changes
+// the browser spends most of the robot computer's CPU drawing (bench/view_load.py); the
+// multisampling was half of a frame, and a click waits behind frames
+// (bench/click_latency.py). So "auto" is half there and full elsewhere.
 function viewSrc() {
   const half = settings.viewDetail === "half" || (settings.viewDetail === "auto" && softwareGL);
-  const url = new URL(viewUrl);
-  if (half) url.searchParams.set("fixedDpr", "0.5");
+  const url = new URL("view", location.href);
+  url.searchParams.set("websocket", viewUrl.replace(/^http/, "ws"));
+  if (half) {
+    url.searchParams.set("fixedDpr", "0.5");
+    url.searchParams.set("multisample", "0");
+  }
   return url.href;
 }
 
@@ -888,7 +894,7 @@ async function findView() {
   if (!viewUrl) { setTimeout(findView, 2000); return; }
   showView(settings.showView);
 }
-// Behind the proxy the view is same-origin: let Esc stop from inside it too.
+// The view is same-origin (/view): let Esc stop from inside it too.
 $("view").addEventListener("load", () => {
   try {
     $("view").contentWindow.addEventListener("keydown", (e) => {
