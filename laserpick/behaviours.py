@@ -94,13 +94,16 @@ def turned_hand_xy(spot_xy: np.ndarray, middle_xy: np.ndarray, dyaw: float) -> n
 @dataclass(frozen=True)
 class Outcome:
     """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage;
-    spot: where a place set the object down (the surface point under the TCP, m, `base`)."""
+    spot: where a place set the object down (the surface point under the TCP, m, `base`);
+    closed_width: a pick's finger gap once it has squeezed again after the first lift (m),
+    beside `grasp.width`, the width it planned: an object turned in the pads shows less."""
 
     failure: Failure | None = None
     grasp: Grasp | None = None
     attempts: int = 0
     timings: dict[str, float] = field(default_factory=dict)
     spot: np.ndarray | None = None
+    closed_width: float | None = None
 
     @property
     def ok(self) -> bool:
@@ -365,6 +368,7 @@ class Behaviours:
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)
         self.robot.sleep(0.3)
+        closed = self.robot.gripper_state().width
         failure = failure or self._run(plan.lift, "lifting")
         self.robot.sleep(0.3)
         if failure is None and not self.robot.gripper_state().holding:
@@ -374,12 +378,12 @@ class Behaviours:
                 self.robot.gripper(False)
                 self.robot.sleep(GRIPPER_TIME)
                 self.held = None
-            return Outcome(failure, grasp, attempts, timings)
+            return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         failure = self._withdraw(grasp.approach, around, pts_tcp)
         if failure:  # the hand keeps what it holds: the session tucks it in
-            return Outcome(failure, grasp, attempts, timings)
+            return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         self.progress("Holding the object.")
-        return Outcome(None, grasp, attempts, timings)
+        return Outcome(None, grasp, attempts, timings, closed_width=closed)
 
     def _withdraw(
         self,
@@ -392,19 +396,34 @@ class Behaviours:
         clear of `checker`, with `payload` in the hand): after a lift, out of a shelf's gap
         before the arm swings anywhere (a swing planned from inside the 69 cm shelf found
         no way out, or met the board above); after a place, off the object it let go of.
-        A grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising."""
+        A grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising.
+
+        An arm that starts within the checker's margin of something (beside a cereal box
+        set down on the counter, it stood within 1 cm of points the place-time capture saw
+        there, and the hand rose about the box's top instead) still leaves, if the way keeps
+        the clearance it starts with: half the margin, or none short of touching."""
         level = np.hypot(*approach[:2])
         if level < np.sin(WITHDRAW_STEEP):
             return None
         s = self.settings.motion
         back = -np.append(approach[:2] / level, 0.0)
         q = self._q()
+        margin = next(
+            (
+                m
+                for m in (checker.margin, checker.margin / 2, 0.0)
+                if checker.clearance_ok(q, payload=payload, margin=m)[0]
+            ),
+            None,
+        )
+        if margin is None:  # touching already: no level way out is known to be clear
+            return None
         here = tcp_pose(q)
         for distance in (s.approach_distance, s.approach_distance / 2):
             T = here.copy()
             T[:3, 3] += distance * back
             path = cartesian_line(q, T, s.cartesian_step)
-            if path is None or not checker.clearance_ok(path, payload=payload).all():
+            if path is None or not checker.clearance_ok(path, payload=payload, margin=margin).all():
                 continue
             return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
         return None

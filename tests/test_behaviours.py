@@ -614,3 +614,28 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     _, above = _hand_at(b, _top_down(1.6, -0.3, 0.8))
     assert b._leave_placed(above, free) is None
     np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
+
+
+def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_clear(robot):
+    """Something 5-10 mm ahead of the fingers (inside the 1 cm margin) does not keep the hand
+    from drawing back away from it; something the way back comes closer to does."""
+    b = Behaviours(robot)
+    side = _side_pose(1.70, -0.30, 0.80)
+    q_side, _ = _hand_at(b, side)
+    ahead = None
+    for x in np.arange(1.70, 1.90, 0.001):
+        near = CollisionChecker(np.array([[x, -0.30, 0.80]]))
+        if near.clearance_ok(q_side, margin=0.005)[0] and not near.clearance_ok(q_side)[0]:
+            ahead = near
+            break
+    assert ahead is not None, "no point ahead of the hand lies 5-10 mm from it"
+    assert b._withdraw(side[:3, 2], ahead) is None
+    np.testing.assert_allclose(
+        tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
+    )
+    # Inside the margin already, and a post behind: it stays.
+    _hand_at(b, side)
+    both = CollisionChecker(np.vstack([ahead.points, _post_behind(q_side).points]))
+    stood = robot.joint_state().q
+    assert b._withdraw(side[:3, 2], both) is None
+    np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)

@@ -213,6 +213,9 @@ def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:
         if r["failure"] not in ("detect_laser", "precondition", "detect_grasp"):
             assert r["timings"]["plan"] > 0
             assert r["timings"]["attempt_total"] >= r["timings"]["plan"]
+        if r["grasped"]:  # a lifted object: the width planned and the gap closed to, in m
+            planned, closed = r["grip"]
+            assert 0 < planned <= dims.GRIPPER_STROKE and closed > dims.GRIPPER_EMPTY_GAP
 
 
 def test_bench_command_on_a_user_mesh_scene(tmp_path: Path) -> None:

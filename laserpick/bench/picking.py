@@ -70,6 +70,9 @@ class Attempt:
     failure: str | None = None  #: one of FAILURE_KINDS when it did not succeed
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)  #: s per STAGES entry
+    #: the executed grasp's planned width and the finger gap it closed to (m): an object
+    #: held across an edge or turned in the pads closes narrower than planned
+    grip: tuple[float, float] | None = None
 
     def fail(self, kind: str, message: str) -> Attempt:
         self.failure, self.message = kind, message
@@ -243,6 +246,9 @@ class ScriptedOperator:
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
+            closed = executed[-1].get("closed_width")
+            if closed is not None:
+                rec.grip = (executed[-1]["grasp"]["width"], closed)
         rec.detected = self.referee.object_at(chosen, before) == rec.instance
         lifted = any(e.get("state") == "holding" for e in self._events_since(k, "state"))
         rec.grasped = lifted and rec.detected  # what was lifted was the marked object

@@ -867,7 +867,12 @@ class Session:
         out = self.behaviours.pick(grasps, order)
         self.task.timings.update(out.timings)
         if out.grasp is not None:  # the grasp that planned: in auto, not always the first
-            self._emit("grasp_executed", grasp=grasp_summary(out.grasp), tried=out.attempts)
+            self._emit(
+                "grasp_executed",
+                grasp=grasp_summary(out.grasp),
+                tried=out.attempts,
+                closed_width=None if out.closed_width is None else round(out.closed_width, 4),
+            )
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)
