@@ -780,9 +780,12 @@ class Behaviours:
         looks for the surface), and the pose above. The grasp's orientation is kept, so that the
         object stands as it stood, turned about the vertical if the arm cannot reach it
         unturned (PLACE_YAWS): a turned object still stands upright, and where it would have
-        stood unturned (the hand over the mark, 004 section 7.3)."""
+        stood unturned (the hand over the mark, 004 section 7.3). The arm (not the hand and
+        what it holds, which go down onto the surface) must keep clear of `checker` on the
+        way down to the rest: unchecked, the wrist came down 3 mm over a mug set down
+        earlier beside the spot, and after the release the hand found no way out."""
         s = self.settings.motion
-        reached = False
+        reached = crowded = False
         # The middle of the held object, from the hand (m, `base` axes at the grasp).
         pts = held.points_tcp @ held.grasp.pose[:3, :3].T
         middle = (pts.min(axis=0) + pts.max(axis=0)) / 2 if len(pts) else np.zeros(3)
@@ -800,12 +803,21 @@ class Behaviours:
                 if checker.clearance_ok(q, payload=held.points_tcp)[0]
             ]
             reached = reached or bool(clear)
+            T_rest = T_place.copy()
+            T_rest[2, 3] = rest
             for q_above in clear:
                 down = cartesian_line(q_above, T_place, s.cartesian_step)
-                if down is not None:
-                    return q_above, down, T_above
+                to_rest = cartesian_line(q_above, T_rest, s.cartesian_step)
+                if down is None or to_rest is None:
+                    continue
+                if not checker.clearance_ok(to_rest, hand=False).all():
+                    crowded = True
+                    continue
+                return q_above, down, T_above
         if not reached:
             return Failure("ik_plan", "The arm cannot reach above that spot.")
+        if crowded:
+            return Failure("ik_plan", "The arm would come down too close to something there.")
         return Failure("ik_plan", "The arm cannot lower the object there.")
 
     @staticmethod

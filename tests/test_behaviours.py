@@ -10,14 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from laserpick.behaviours import PLACE_YAWS, Behaviours, drop_candidates, turned_hand_xy
+from laserpick.behaviours import PLACE_YAWS, Behaviours, Held, drop_candidates, turned_hand_xy
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
 from laserpick.bench.truth import Captured
 from laserpick.description import dims
+from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.collision import SPHERES, CollisionChecker, sphere_centres
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
@@ -639,3 +640,40 @@ def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_
     stood = robot.joint_state().q
     assert b._withdraw(side[:3, 2], both) is None
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
+
+
+def test_the_hand_comes_down_turned_where_the_arm_would_come_down_on_something(robot):
+    """Something where the wrist would come down, unturned, behind a hand that holds from the
+    side: the place turns the hand (PLACE_YAWS) so that the arm comes down clear of it.
+    Unchecked, the wrist came down 3 mm over a mug set down earlier beside the spot, and the
+    open hand then found no way out."""
+    b = Behaviours(robot)
+    side = _side_pose(1.70, -0.30, 0.80)
+    q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q))
+    ring = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    can = np.c_[0.03 * np.cos(ring), 0.03 * np.sin(ring), 0 * ring]
+    held = Held(
+        Grasp(pose=side, width=0.06, ik=q_side), 0.05, can, CollisionChecker(np.zeros((0, 3)))
+    )
+    spot = np.array([1.60, -0.30, 0.70])
+    found = b._place_poses(held, spot, q_side, CollisionChecker(np.zeros((0, 3))))
+    assert not isinstance(found, Failure), found
+    q_above, down, _ = found
+    rest = spot[2] + held.height_above_support
+
+    def to_rest(path: np.ndarray) -> np.ndarray:
+        return np.array([q for q in path if tcp_pose(q)[2, 3] >= rest - 1e-3])
+
+    # A small post where the arm's sphere nearest the hand, behind it, comes down to.
+    last = to_rest(down)[-1]
+    centres = sphere_centres(body_frames(last[None]))[0][~SPHERES.hand]
+    tcp = tcp_pose(last)[:3, 3]
+    near = centres[np.argmin(np.linalg.norm(centres - tcp, axis=1))]
+    g = np.arange(-0.01, 0.011, 0.01)
+    post = CollisionChecker(near + np.stack(np.meshgrid(g, g, g), -1).reshape(-1, 3))
+    assert not post.clearance_ok(to_rest(down), hand=False).all()
+    found = b._place_poses(held, spot, q_side, post)
+    assert not isinstance(found, Failure), found
+    q_turned, down_turned, _ = found
+    assert not np.allclose(q_turned, q_above)
+    assert post.clearance_ok(to_rest(down_turned), hand=False).all()
