@@ -398,10 +398,9 @@ class Behaviours:
         no way out, or met the board above); after a place, off the object it let go of.
         A grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising.
 
-        An arm that starts within the checker's margin of something (beside a cereal box
-        set down on the counter, it stood within 1 cm of points the place-time capture saw
-        there, and the hand rose about the box's top instead) still leaves, if the way keeps
-        the clearance it starts with: half the margin, or none short of touching."""
+        An arm that starts within the checker's margin of something (set down beside other
+        objects, say) still leaves, if the whole way keeps the clearance it starts with:
+        half the margin, or none short of touching."""
         level = np.hypot(*approach[:2])
         if level < np.sin(WITHDRAW_STEEP):
             return None
