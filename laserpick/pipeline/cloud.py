@@ -184,9 +184,9 @@ def ray_distance(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -
     """How far (m) `point` (3,) lies from the ray from `origin` (3,) along `direction` (3,):
     from the line ahead of the origin, or from the origin for a point behind it. A second
     click on the laser's dot passes through the aimed point. All in one frame."""
+    d = _unit(direction)
     rel = np.asarray(point, dtype=np.float64) - np.asarray(origin, dtype=np.float64)
-    along = max(float(rel @ _unit(direction)), 0.0)
-    return float(np.linalg.norm(rel - along * _unit(direction)))
+    return float(np.linalg.norm(rel - max(float(rel @ d), 0.0) * d))
 
 
 def ray_hit(

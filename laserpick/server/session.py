@@ -161,6 +161,10 @@ class _Foreseen:
     perception: Perception
     lit: np.ndarray | None
 
+    def of(self, capture: _Capture | None, point: np.ndarray) -> bool:
+        """Whether this is the mark at `point` (m, `base`) worked out in `capture`."""
+        return self.capture is capture and np.array_equal(self.point, point)
+
 
 def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
     return None if a is None else [round(float(x), digits) for x in np.ravel(a)]
@@ -501,12 +505,7 @@ class Session:
                     self._require_motion(actor, "laser/confirm")
                 self._set(TaskState.MARKED, "Marked. Looking at the object.")
                 seen = self._foreseen
-                if (
-                    point is not None
-                    and seen is not None
-                    and seen.capture is self._capture
-                    and np.array_equal(seen.point, point)
-                ):
+                if point is not None and seen is not None and seen.of(self._capture, point):
                     # Worked out since the aim, and the job will take this same result:
                     # the projector lights the target now, not after the job's first step.
                     self._projection = seen.lit
@@ -764,7 +763,7 @@ class Session:
 
     def _work_out(self, capture: _Capture | None, point: np.ndarray, seq: int) -> _Foreseen | None:
         seen = self._foreseen
-        if seen is not None and seen.capture is capture and np.array_equal(seen.point, point):
+        if seen is not None and seen.of(capture, point):
             return seen
         if seq != self._foresee_seq or capture is None or capture is not self._fresh_capture():
             return None
