@@ -4,6 +4,7 @@ in worker processes and on Ray, and the `laserpick bench` command's files."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
 import subprocess
@@ -30,14 +31,15 @@ from laserpick.bench.operator import (
     parking_pose,
     plan_drive,
 )
+from laserpick.bench.picking import BENCH, LEVER_MAX, lever
 from laserpick.bench.protocols import (
     FLOOR_TURNS,
     JEEVES_MODELS,
     PROTOCOLS,
     UPRIGHT_TILT,
     Options,
+    _aims_in_sight,
     _operated,
-    _spot_in_sight,
     _still_there,
     coin_flip_kitchen,
     jeeves_scene,
@@ -305,6 +307,50 @@ def test_the_user_sees_whether_the_dot_is_on_the_object() -> None:
         cap.close()
 
 
+def test_a_grasps_lever_is_its_objects_weight_arm_about_the_line_between_the_fingers() -> None:
+    """Hand-worked: fingers closing along y at the origin; the weight 5 cm ahead (x) turns
+    the object about them with a 5 cm arm, wherever it lies along that line or below it."""
+    pose = np.eye(4)  # closing axis: the pose's y column
+    assert lever(pose, np.array([0.05, 0.30, -0.02])) == pytest.approx(0.05)
+    assert lever(pose, np.array([0.0, 0.07, -0.04])) == pytest.approx(0.0)
+    diagonal = np.eye(4)
+    diagonal[:3, 1] = [math.sqrt(0.5), math.sqrt(0.5), 0.0]
+    assert lever(diagonal, np.array([0.1, 0.1, 0.0])) == pytest.approx(0.0)
+    assert lever(diagonal, np.array([0.1, 0.0, 0.0])) == pytest.approx(0.1 * math.sqrt(0.5))
+    upright = np.eye(4)
+    upright[:3, 1] = [0.0, 0.0, 1.0]  # fingers above and below: the weight pulls along them
+    assert lever(upright, np.array([0.05, 0.05, 0.0])) == pytest.approx(0.0)
+
+
+def test_choosing_by_hand_the_user_holds_a_remote_across_its_middle(tmp_path: Path) -> None:
+    """A TV remote lying across the table: the best clusters hold it near an end, where it
+    would swing in the pads; the user steps past them to the first that holds it across its
+    middle, as a person looking at the outlines would."""
+    scene = tmp_path / "remote.yaml"
+    scene.write_text(
+        "name: remote\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: t, kind: table, xy: [1.6, -0.2], size: [0.6, 1.0], height: 0.46}\n"
+        "objects:\n  - {name: remote, model: tv_remote, on: t, xy: [1.42, -0.25], yaw_deg: 90}\n"
+    )
+    with _operated(load_scene(str(scene)), 0, 1, Options(tremor_deg=0.0)) as op:
+        s = op.session
+        s.set_mode(BENCH, selection="manual", mode="pick_and_place")
+        assert op.mark(op.new_attempt("remote", "manual", "gpd"))
+        before = op.referee.all_object_points()
+        centre = op.referee.centre_of_mass("remote")
+        levers = []
+        for k in range(s.status()["grasps"]["clusters"]):
+            s.select_grasp(BENCH, k, 0)
+            pose = np.asarray(s.status()["current"]["pose"])
+            assert op.referee.object_at(pose[:3, 3], before) == "remote"
+            levers.append(lever(pose, centre))
+        assert levers[0] > LEVER_MAX, "this scene should rank a grasp near an end first"
+        op.choose("remote", before)
+        chosen = s.status()["grasps"]["cluster"]
+        assert levers[chosen] <= LEVER_MAX
+        assert all(x > LEVER_MAX for x in levers[:chosen])
+
+
 def test_the_helper_empties_the_basket_of_any_object_after_an_attempt() -> None:
     """An object that fell in the basket (a wrong object's pick) stands in the laser's way;
     tidying after the attempt takes it out, whatever it was."""
@@ -390,7 +436,8 @@ def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
     tmp_path: Path,
 ) -> None:
     """A person watches the dot before confirming a place mark: where a box between the seat
-    and the spot takes it, they move the aim aside until the dot lies on the free table."""
+    and the spot takes it, they move the aim aside until the dot lies on the free table.
+    Where the robot refuses a mark, they move it on to the next such aim."""
     scene = tmp_path / "box.yaml"
     scene.write_text(
         "name: box\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
@@ -403,14 +450,15 @@ def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
         hidden = np.array([1.65, 0.12, 0.46])  # 25 cm behind the box, seen from the seat
         op.aim(op.referee.to_base(hidden))
         assert op.referee.dot_on("box"), "the box hides the spot"
-        target = _spot_in_sight(op, table, hidden)
+        target = next(_aims_in_sight(op, table, hidden))
         assert np.linalg.norm(target - op.referee.to_base(hidden)) > 0.04
         op.aim(target)
         assert not op.referee.dot_on("box")
         assert np.linalg.norm(op.referee.to_base(op.robot.laser_hits()[0]) - target) < 0.03
         in_sight = np.array([1.65, -0.40, 0.46])
-        target = _spot_in_sight(op, table, in_sight)
-        assert np.allclose(target, op.referee.to_base(in_sight))
+        first, second, *_ = itertools.islice(_aims_in_sight(op, table, in_sight), 3)
+        assert np.allclose(first, op.referee.to_base(in_sight))
+        assert 0.04 < np.linalg.norm(second - first) < 0.06  # 5 cm across, still on the top
 
 
 def test_a_pick_place_task_is_tried_again_while_its_object_stands_where_it_stood(

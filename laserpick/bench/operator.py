@@ -75,6 +75,11 @@ class Referee:
         """The object's origin in `world` (m): the centre of its bottom face when upright."""
         return self.robot.sim.snapshot().xpos[self.robot.sim.info.object_bodies[instance]].copy()
 
+    def centre_of_mass(self, instance: str) -> np.ndarray:
+        """The object's centre of mass in `base` (m) now."""
+        body = self.robot.sim.info.object_bodies[instance]
+        return self.to_base(self._posed().xipos[body])
+
     def world_quat(self, instance: str) -> np.ndarray:
         """The object's orientation in `world` (w, x, y, z)."""
         b = self.robot.sim.info.object_bodies[instance]

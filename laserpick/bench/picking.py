@@ -45,6 +45,10 @@ REMARKS = 2
 AIMS = 5
 #: Longest a session job may take (s of wall time) before the run is declared hung.
 JOB_TIMEOUT = 600.0
+#: The farthest (m) a user choosing by hand lets a grasp hold an object off its balance: an
+#: object held farther from its centre of mass, across the line between the fingers, swings
+#: about that line in the pads (a TV remote held near one end was set down on its side).
+LEVER_MAX = 0.02
 #: The session's progress messages at the moment the hand lets go of the object.
 RELEASED = frozenset({"Released into the basket.", "Placed."})
 
@@ -73,6 +77,8 @@ class Attempt:
     #: the executed grasp's planned width and the finger gap it closed to (m): an object
     #: held across an edge or turned in the pads closes narrower than planned
     grip: tuple[float, float] | None = None
+    #: how far (m) the executed grasp held the object off its centre of mass (`lever`)
+    lever: float | None = None
 
     def fail(self, kind: str, message: str) -> Attempt:
         self.failure, self.message = kind, message
@@ -213,15 +219,24 @@ class ScriptedOperator:
 
     def choose(self, instance: str, before: dict[str, np.ndarray]) -> None:
         """Manual selection (004 section 7.2): step through the clusters, best first, to the
-        first whose best grasp closes on `instance`; none such: back to the system's choice."""
+        first whose best grasp closes on `instance` across its middle (a `lever` of at most
+        LEVER_MAX), as a person who sees the object would hold it; else to the first on
+        `instance` at all; none such: back to the system's choice."""
         s = self.session
-        clusters = s.status()["grasps"]["clusters"]
-        for k in range(clusters):
+        centre = self.referee.centre_of_mass(instance)
+        first_on = None
+        for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
-            position = np.asarray(s.status()["current"]["position"])
-            if self.referee.object_at(position, before) == instance:
+            pose = np.asarray(s.status()["current"]["pose"])
+            if self.referee.object_at(pose[:3, 3], before) != instance:
+                continue
+            if lever(pose, centre) <= LEVER_MAX:
                 return
-        s.auto_grasp(BENCH)
+            first_on = k if first_on is None else first_on
+        if first_on is not None:
+            s.select_grasp(BENCH, first_on, 0)
+        else:
+            s.auto_grasp(BENCH)
 
     def pick(self, rec: Attempt, aim: np.ndarray | None = None) -> bool:
         """Mark `rec.instance`, choose a grasp the way `rec.selection` says, and execute.
@@ -233,6 +248,7 @@ class ScriptedOperator:
         if not self.mark(rec, aim):
             return False
         before = self.referee.all_object_points()  # judge grasps by the scene they were made for
+        centre = self.referee.centre_of_mass(rec.instance)
         if rec.selection == "manual":
             self.choose(rec.instance, before)
         chosen = np.asarray(s.status()["current"]["position"])
@@ -246,6 +262,7 @@ class ScriptedOperator:
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
+            rec.lever = round(lever(np.asarray(executed[-1]["grasp"]["pose"]), centre), 4)
             closed = executed[-1].get("closed_width")
             if closed is not None:
                 rec.grip = (executed[-1]["grasp"]["width"], closed)
@@ -321,6 +338,17 @@ class ScriptedOperator:
             if out is None or not out.ok:
                 self.referee.move_arm_home()
         s.resync(BENCH)
+
+
+def lever(pose: np.ndarray, centre: np.ndarray) -> float:
+    """How far (m) a grasp at `pose` (4 x 4 TCP pose, `base`) holds an object off its centre
+    of mass `centre` (m, `base`), as gravity sees it: the lever arm of the object's weight
+    about the line between the fingers, about which it turns in the pads. With c the
+    closing axis and d the centre's offset from the TCP, the weight's torque about c is
+    m g (c_x d_y - c_y d_x): the level distance from the centre to the upright plane through
+    that line when the fingers close level, and none when they close straight up and down."""
+    c, d = pose[:3, 1], centre - pose[:3, 3]
+    return abs(float(c[0] * d[1] - c[1] * d[0]))
 
 
 @dataclass(frozen=True)

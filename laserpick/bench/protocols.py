@@ -29,6 +29,7 @@ are worked through in the protocol's way (for selection, each trial marks one ra
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections.abc import Callable, Iterator
@@ -449,13 +450,18 @@ def _free(objects: list[np.ndarray], xy: np.ndarray, level: float) -> bool:
     return all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1)
 
 
-def _spot_in_sight(op: ScriptedOperator, surface: Surface, spot: np.ndarray) -> np.ndarray:
-    """Where the user marks to put something at `spot` (m, `world`, on `surface`'s top):
-    the spot itself, or, where the dot lands on something in front of it, the first aim of
-    AIM_SHIFTS that is free, on the surface and lit by the dot (`base`, m)."""
+def _aims_in_sight(
+    op: ScriptedOperator, surface: Surface, spot: np.ndarray
+) -> Iterator[np.ndarray]:
+    """Where the user marks, in turn, to put something at `spot` (m, `world`, on `surface`'s
+    top; `base` out): each aim of AIM_SHIFTS that is free, on the surface and lit by the
+    dot (the spot itself first, where the dot lands on it), then the last of them (the spot,
+    where none is) for as long as asked. A person moves the mark on when the dot lands on
+    something in front of the spot, and when the robot refuses to place there."""
     half = np.asarray(surface.size[:2]) / 2
     local = surface.to_local(spot[:2])
     objects = _objects(op)
+    last = None
     for dx, dy in AIM_SHIFTS:
         moved = local + (dx, dy)
         xy = surface.to_world(moved)
@@ -465,8 +471,11 @@ def _spot_in_sight(op: ScriptedOperator, surface: Surface, spot: np.ndarray) -> 
         op.aim(target)
         hits = op.robot.laser_hits()
         if hits and np.linalg.norm(op.referee.to_base(hits[0]) - target) < DOT_ON_SPOT:
-            return target
-    return op.referee.to_base(spot)
+            last = target
+            yield target
+    last = op.referee.to_base(spot) if last is None else last
+    while True:
+        yield last
 
 
 def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
@@ -561,9 +570,9 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         failure = Failure("precondition", f"the user could not park at {dest.name}")
     else:
         return rec.fail(failure.kind, failure.message)
-    spot_base = _spot_in_sight(op, dest, spot_world)
-    for _ in range(MAX_TRIES):  # the user marks again while the hand still holds it
-        placed = op.place(spot_base)
+    aims = _aims_in_sight(op, dest, spot_world)
+    for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand still holds it
+        placed = op.place(aim)
         rec.places += 1
         if placed.failure is None or session.state not in HOLDING_STATES:
             break
