@@ -68,6 +68,11 @@ RISE_OUT = 0.05
 WITHDRAW_STEEP = np.radians(30.0)
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
+#: Turns (rad) of the last wrist joint tried, in order, for a pose the arm holds an object in
+#: on the way (tucked in, raised in front): an object held by one end reaches back along the
+#: hand, and at one turn it comes within the margin of the upper arm where at another it
+#: hangs clear (a banana held 8 cm off its middle could be neither tucked in nor raised).
+HOLD_TURNS = (0.0, np.pi, np.pi / 2, -np.pi / 2)
 #: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
 PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
 #: How far (rad) the arm may be from a trajectory's start when it is sent, and how long (s)
@@ -583,18 +588,29 @@ class Behaviours:
         failure = self._rise_clear(held.surroundings, held.points_tcp)
         if failure is not None:
             return Outcome(failure)
+        high = self._holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp)
         out = self.go_to(
-            dims.UR5_CARRY_Q,
+            self._holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp),
             held.surroundings,
             "tucking it in",
-            via=(dims.UR5_HIGH_READY_Q,),
+            via=(high,),
             payload=held.points_tcp,
         )
         if out.ok or out.failure is None or out.failure.kind != "ik_plan":
             return out  # it went there, or a motion was stopped: no second one
-        return self.go_to(
-            dims.UR5_HIGH_READY_Q, held.surroundings, "raising", payload=held.points_tcp
-        )
+        return self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
+
+    @staticmethod
+    def _holding_pose(q: np.ndarray, checker: CollisionChecker, payload: np.ndarray) -> np.ndarray:
+        """`q` (6,) rad with the last wrist joint turned by the first of HOLD_TURNS at which
+        the arm and what it holds (`payload`, TCP frame) keep clear of `checker`; `q` itself
+        where none does (the planner then says it found no way)."""
+        for turn in HOLD_TURNS:
+            turned = q.copy()
+            turned[5] += turn
+            if checker.clearance_ok(turned, payload=payload)[0]:
+                return turned
+        return q
 
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready (stowed
@@ -611,12 +627,13 @@ class Behaviours:
         failure = self._rise_clear(held.surroundings, held.points_tcp)
         if failure is not None:
             return Outcome(failure)
+        high = self._holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp)
         for q_drop in drops[:DROP_TRIES]:
             out = self.go_to(
                 q_drop,
                 held.surroundings,
                 "carrying to the basket",
-                via=(dims.UR5_HIGH_READY_Q,),
+                via=(high,),
                 payload=held.points_tcp,
             )
             if out.ok or out.failure is None or out.failure.kind != "ik_plan":
@@ -686,7 +703,7 @@ class Behaviours:
             q_above,
             checker,
             "carrying to the place",
-            via=(dims.UR5_HIGH_READY_Q,),
+            via=(self._holding_pose(dims.UR5_HIGH_READY_Q, checker, held.points_tcp),),
             payload=held.points_tcp,
         )
         if not out.ok:

@@ -10,7 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from laserpick.behaviours import PLACE_YAWS, Behaviours, Held, drop_candidates, turned_hand_xy
+from laserpick.behaviours import (
+    PLACE_YAWS,
+    Behaviours,
+    Held,
+    drop_candidates,
+    turned_hand_xy,
+)
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
 from laserpick.bench.truth import Captured
@@ -677,3 +683,24 @@ def test_the_hand_comes_down_turned_where_the_arm_would_come_down_on_something(r
     q_turned, down_turned, _ = found
     assert not np.allclose(q_turned, q_above)
     assert post.clearance_ok(to_rest(down_turned), hand=False).all()
+
+
+def test_an_object_held_by_one_end_is_tucked_in_with_the_hand_turned_away_from_the_arm(robot):
+    """A banana held 8 cm off its middle reaches 19 cm back along the hand: at the carry
+    pose, and raised in front, it would come within the margin of the upper arm. The last
+    wrist joint turns it the other way, and the arm tucks it in. (Unturned, no goal was
+    clear, and the arm kept it where it had lifted it: "no collision-free path for
+    raising".)"""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    rod = np.mgrid[-0.19:0.021:0.01, -0.02:0.021:0.01, -0.02:0.011:0.01].reshape(3, -1).T
+    free = CollisionChecker(np.zeros((0, 3)))
+    assert not free.clearance_ok(dims.UR5_CARRY_Q, payload=rod)[0]
+    assert not free.clearance_ok(dims.UR5_HIGH_READY_Q, payload=rod)[0]
+    b.held = Held(Grasp(pose=tcp_pose(b._q()), width=0.03, ik=b._q()), 0.02, rod, free)
+    out = b.tuck()
+    assert out.ok, out.failure
+    q = robot.joint_state().q
+    assert np.allclose(q[:5], dims.UR5_CARRY_Q[:5], atol=0.02)
+    assert abs(q[5] - dims.UR5_CARRY_Q[5]) > 1.0  # turned
+    assert free.clearance_ok(q, payload=rod)[0]
