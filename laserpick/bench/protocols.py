@@ -91,11 +91,10 @@ UPRIGHT_TILT = math.radians(15.0)
 PLACE_TOLERANCE = 0.03
 #: Where the dot of a place mark lands on something in front of the spot (an object between
 #: the seat and it), the user moves the aim by these (m, the surface's x back and y across)
-#: until the dot lies within DOT_ON_SPOT (m) of where they aim, as a person who watches
-#: the dot does; three marks on the side of a box in front of the spot were refused ("not
-#: on a flat surface") and the task was lost.
+#: until the dot lies within `picking.DOT_ON_SPOT` of where they aim, as a person who
+#: watches the dot does; three marks on the side of a box in front of the spot were refused
+#: ("not on a flat surface") and the task was lost.
 AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), (0.05, 0.0))
-DOT_ON_SPOT = 0.03
 #: The laser-scan protocol's step between aim points (m), 002's "about 1.5 cm".
 SCAN_STEP = 0.015
 #: The models of the two-object selection trials: the `isolation` set less the tall cereal
@@ -468,9 +467,8 @@ def _aims_in_sight(
         if np.any(np.abs(moved) > half - 0.05) or not _free(objects, xy, spot[2]):
             continue
         target = op.referee.to_base(np.array([xy[0], xy[1], spot[2]]))
-        op.aim(target)
-        hits = op.robot.laser_hits()
-        if hits and np.linalg.norm(op.referee.to_base(hits[0]) - target) < DOT_ON_SPOT:
+        op.aim(target, watched=True)
+        if op.dot_near(target):
             last = target
             yield target
     last = op.referee.to_base(spot) if last is None else last
