@@ -460,8 +460,9 @@ class Behaviours:
         self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
     ) -> list[np.ndarray]:
         """Clear joint configurations that hold the object over the basket's opening, best
-        first (rad): those of `drop_candidates()`, and where none of them holds the whole
-        object inside, the tilted ones after them.
+        first (rad): those of `drop_candidates()`, and where fewer than DROP_TRIES of them
+        hold the whole object inside, the tilted ones after them (a cereal box held at its
+        top fitted inside from one upright posture only, which no path reached).
 
         Postures that hold every point of the object inside the opening (1 cm in from the
         walls) come first, then those that hold its middle there; then the shortest fall
@@ -473,7 +474,7 @@ class Behaviours:
         the projector, so few postures reach over it: they are searched, not assumed.
         """
         ranked = self._rank_drops(drop_candidates(), q_ref, checker, payload)
-        if not ranked or ranked[0][0][0] > 0:
+        if sum(key[0] == 0 for key, _ in ranked) < DROP_TRIES:
             ranked += self._rank_drops(drop_candidates(tilted=True), q_ref, checker, payload)
         return [q for _, q in ranked]
 

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from laserpick.behaviours import (
+    DROP_TRIES,
     PLACE_YAWS,
     Behaviours,
     Held,
@@ -502,6 +503,23 @@ def test_a_tall_object_held_at_its_top_is_laid_over_the_basket(robot):
         assert np.all((middle > lo) & (middle < hi))
         assert held[:, 2].min() > dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
         assert free.clearance_ok(q, payload=payload)[0]
+
+
+def test_an_object_that_fits_the_basket_from_few_upright_postures_may_also_be_laid_over_it(
+    robot,
+):
+    """A 20 cm tall object held near one end fits inside the opening from one upright
+    posture only; should no path reach that one, the tilted postures come next (a cereal
+    box whose one upright posture no path reached stayed in the hand)."""
+    payload = np.mgrid[-0.02:0.1001:0.02, -0.02:0.0401:0.02, -0.03:0.2001:0.02].reshape(3, -1).T
+    free = CollisionChecker(np.zeros((0, 3)))
+    upright = [q for q in drop_candidates() if free.clearance_ok(q, payload=payload)[0]]
+    assert 1 <= len(upright) < DROP_TRIES
+    drops = Behaviours(robot).drop_configurations(dims.UR5_READY_Q, free, payload)
+    assert any(np.allclose(drops[0], q) for q in upright)  # the upright one first
+    tilted = drops[len(upright) :]
+    assert tilted, "tilted postures follow"
+    assert not any(np.allclose(t, q) for t in tilted for q in drop_candidates())
 
 
 def test_a_tall_object_is_picked_and_dropped_in_the_basket():
