@@ -345,7 +345,7 @@ def test_choosing_by_hand_the_user_holds_a_remote_across_its_middle(tmp_path: Pa
             assert op.referee.object_at(pose[:3, 3], before) == "remote"
             levers.append(lever(pose, centre))
         assert levers[0] > LEVER_MAX, "this scene should rank a grasp near an end first"
-        op.choose("remote", before)
+        op.choose("remote", before, centre)
         chosen = s.status()["grasps"]["cluster"]
         assert levers[chosen] <= LEVER_MAX
         assert all(x > LEVER_MAX for x in levers[:chosen])

@@ -229,13 +229,13 @@ class ScriptedOperator:
         s.cancel(BENCH)
         return False
 
-    def choose(self, instance: str, before: dict[str, np.ndarray]) -> None:
+    def choose(self, instance: str, before: dict[str, np.ndarray], centre: np.ndarray) -> None:
         """Manual selection (004 section 7.2): step through the clusters, best first, to the
         first whose best grasp closes on `instance` across its middle (a `lever` of at most
-        LEVER_MAX), as a person who sees the object would hold it; else to the first on
-        `instance` at all; none such: back to the system's choice."""
+        LEVER_MAX about its centre of mass `centre`, m, `base`), as a person who sees the
+        object would hold it; else to the first on `instance` at all; none such: back to the
+        system's choice."""
         s = self.session
-        centre = self.referee.centre_of_mass(instance)
         first_on = None
         for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
@@ -262,7 +262,7 @@ class ScriptedOperator:
         before = self.referee.all_object_points()  # judge grasps by the scene they were made for
         centre = self.referee.centre_of_mass(rec.instance)
         if rec.selection == "manual":
-            self.choose(rec.instance, before)
+            self.choose(rec.instance, before, centre)
         chosen = np.asarray(s.status()["current"]["position"])
         k = len(self._events)
         t_sim = self._sim_time()
