@@ -94,8 +94,9 @@ def _ik(T: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     return sols[0]
 
 
-@pytest.mark.parametrize("name", GRASPED)
-def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
+def _at_grasp(name: str) -> tuple[Simulation, int, np.ndarray, np.ndarray]:
+    """A simulation with the open hand around `name`, ready to close: the simulation, the
+    object's body id, and the arm's grasp and lift configurations (rad)."""
     model = LIBRARY[name]
     assert min_width(model) <= dims.GRIPPER_STROKE
     sim = Simulation(parse_scene(_scene_text(name)), realtime=False)
@@ -106,7 +107,6 @@ def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
     T_base_world = invert(T_world_base)
     p_obj = (T_base_world @ np.append(s.xpos[body], 1.0))[:3]
     q_obj = s.xquat[body]  # the scooter starts unrotated, so world and base share axes
-    z_rest = s.xpos[body][2]
 
     grasp = _top_down_grasp(p_obj, q_obj, model)
     pre = grasp.copy()
@@ -122,6 +122,13 @@ def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
     for q0, q1, speed in ((q_home, q_ready, 1.0), (q_ready, q_pre, 1.0), (q_pre, q_grasp, 0.3)):
         h = sim.execute(_joint_path(q0, q1, speed))
         assert sim.run_until(h, 15.0) == "done", h.message
+    return sim, body, q_grasp, q_lift
+
+
+@pytest.mark.parametrize("name", GRASPED)
+def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
+    sim, body, q_grasp, q_lift = _at_grasp(name)
+    z_rest = sim.snapshot().xpos[body][2]
     sim.gripper(True)
     sim.settle(1.0)
     h = sim.execute(_joint_path(q_grasp, q_lift, 0.3))
@@ -139,3 +146,19 @@ def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
     assert lifted > 0.08, f"{name}: lifted only {lifted * 100:.1f} cm after 5 s"
     drift = z_lifted - s.xpos[body][2]
     assert drift < 0.002, f"{name}: slipped {drift * 1000:.1f} mm in the pads over 5 s"
+
+
+def test_the_fingers_close_together_and_report_the_objects_width():
+    """The 2F-85's linkage moves both fingers as one. A soft coupling let the driven finger
+    push a 6.6 cm can 5 mm across the table and against the other finger, opened to its
+    stop, and the gripper then reported a 4.3 cm width."""
+    sim, body, _, _ = _at_grasp("soda_can")
+    before = sim.snapshot().xpos[body][:2].copy()
+    sim.gripper(True)
+    sim.settle(1.0)
+    s = sim.snapshot()
+    finger_q = s.qpos[sim.info.finger_qpos]
+    assert abs(finger_q[0] - finger_q[1]) < 0.001, f"finger travels {finger_q} (m)"
+    assert s.gripper_width == pytest.approx(0.066, abs=0.002)
+    pushed = np.linalg.norm(s.xpos[body][:2] - before)
+    assert pushed < 0.002, f"closing pushed the can {pushed * 1000:.1f} mm"

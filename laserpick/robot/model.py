@@ -464,6 +464,12 @@ def _add_actuators(spec: mujoco.MjSpec) -> None:
     )
     eq.objtype = mujoco.mjtObj.mjOBJ_JOINT
     eq.data[:5] = [0, 1, 0, 0, 0]
+    # The linkage is rigid. At MuJoCo's default softness the coupling gave way under the
+    # grip force: the driven finger pushed the object 1.1 cm off the hand's centre,
+    # against the other finger opened to its stop.
+    # The stiffest MuJoCo keeps stable: a time constant of two steps.
+    eq.solref = [2 * spec.option.timestep, 1.0]
+    eq.solimp = [0.99, 0.999, 0.001, 0.5, 2.0]
     # Base: velocity servos on the planar joints; the drive turns (v, w) into these.
     for name, kv in zip(BASE_JOINTS, (4000.0, 4000.0, 2000.0), strict=True):
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)

@@ -526,7 +526,7 @@ class Simulation:
 
     def _publish(self) -> None:
         d, info = self.data, self.info
-        width = float(2 * d.qpos[info.finger_qpos[0]])
+        width = float(d.qpos[info.finger_qpos].sum())  # each finger's travel from centre
         force = self._gripper_force()
         yaw = float(d.qpos[info.base_qpos[2]])
         vx, vy = d.qvel[info.base_dof[:2]]
