@@ -67,22 +67,52 @@ def test_approach_factor_eq5_in_an_x_forward_frame():
 
 
 def test_sample_factor_eq6():
-    tcp = np.array([1.0, 0.0, 0.5])
+    g_b = np.array([1.0, 0.0, 0.5])
     sample = np.array([[1.02, 0.0, 0.5], [1.2, 0.0, 0.5]])  # nearest 0.02 m away
-    assert sel.sample_factor(tcp, sample, S) == pytest.approx(1 - 0.02 / 0.05)
-    assert sel.sample_factor(tcp, sample + [1.0, 0, 0], S) == 0.0  # beyond l
-    assert sel.sample_factor(tcp, np.zeros((0, 3)), S) == 0.0
+    assert sel.sample_factor(g_b, sample, S) == pytest.approx(1 - 0.02 / 0.05)
+    assert sel.sample_factor(g_b, sample + [1.0, 0, 0], S) == 0.0  # beyond l
+    assert sel.sample_factor(g_b, np.zeros((0, 3)), S) == 0.0
+
+
+def test_g_b_is_the_hands_bottom_between_the_finger_roots():
+    # A top grasp (approach straight down) with its TCP at z 0.5: the fingertips are
+    # pad_depth / 2 below it, the finger roots finger_length above the tips.
+    g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0]), width=0.05)
+    tips_z = 0.5 - S.pad_depth / 2
+    assert sel.hand_bottom(g.pose, S) == pytest.approx([1.5, 0.0, tips_z + S.finger_length])
+
+
+def test_cs_prefers_the_hand_a_can_fills_to_pads_on_its_top_edge():
+    """Eq. 6 at the hand's bottom: a top grasp whose pads reach 3 cm down a 6.6 cm can
+    scores above one whose pads only reach its top edge."""
+    rng = np.random.default_rng(3)
+    a = rng.uniform(0, 2 * math.pi, 2000)
+    z = rng.uniform(0.46, 0.582, 2000)
+    side = np.c_[1.5 + 0.033 * np.cos(a), 0.033 * np.sin(a), z]
+    r = 0.033 * np.sqrt(rng.uniform(0, 1, 500))
+    b = rng.uniform(0, 2 * math.pi, 500)
+    top = np.c_[1.5 + r * np.cos(b), r * np.sin(b), np.full(500, 0.582)]
+    can = np.vstack([side, top])
+    rim = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p=(1.5, 0.0, 0.582)), width=0.066)
+    deep = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p=(1.5, 0.0, 0.552)), width=0.066)
+    cs = [sel.sample_factor(sel.hand_bottom(g.pose, S), can, S) for g in (rim, deep)]
+    # The rim grasp's bottom stands 3.9 cm above the top: Cs = 1 - 0.039 / 0.05.
+    assert cs[0] == pytest.approx(
+        1 - (S.finger_length - S.pad_depth / 2) / S.finger_length, abs=0.01
+    )
+    assert cs[1] > cs[0] + 0.5
 
 
 def test_mark_factor_eq7():
-    tcp = np.array([1.0, 0.0, 0.5])
-    assert sel.mark_factor(tcp, tcp + [0.04, 0, 0], S) == 1.0  # inside th
-    assert sel.mark_factor(tcp, tcp + [0.15, 0, 0], S) == pytest.approx(math.exp(-1.0))
+    g_b = np.array([1.0, 0.0, 0.5])
+    assert sel.mark_factor(g_b, g_b + [0.04, 0, 0], S) == 1.0  # inside th
+    assert sel.mark_factor(g_b, g_b + [0.15, 0, 0], S) == pytest.approx(math.exp(-1.0))
 
 
 def test_score_multiplies_the_factors_and_needs_ik():
     g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0]), width=0.010, ik=np.full(6, 0.1))
-    scored = sel.score(g, q_now=np.zeros(6), sample=g.position[None, :], mark=g.position)
+    g_b = sel.hand_bottom(g.pose, S)
+    scored = sel.score(g, q_now=np.zeros(6), sample=g_b[None, :], mark=g_b)
     f = scored.scores
     assert f is not None
     assert f.Cw == pytest.approx(2 / 3)
@@ -111,7 +141,8 @@ def _scored(p, total_like: float) -> Grasp:
     # A grasp whose only imperfect factor is Cj, so its score is easy to set.
     g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p), width=0.04, ik=np.zeros(6))
     q_now = np.array([(1 - total_like) * S.joint_distance_max, 0, 0, 0, 0, 0])
-    return sel.score(g, q_now=q_now, sample=np.array([p]), mark=np.array(p))
+    g_b = sel.hand_bottom(g.pose, S)
+    return sel.score(g, q_now=q_now, sample=g_b[None, :], mark=g_b)
 
 
 def test_group_orders_clusters_and_candidates_by_score_and_the_cursor_steps():
