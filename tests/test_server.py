@@ -139,10 +139,15 @@ def remote_goal() -> list[float]:
 
 
 def test_pick_and_place_on_kitchen(client: Client) -> None:
-    """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it."""
+    """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it. The
+    hand brings the point it holds to the mark (004 section 7.3), so the remote's middle
+    lands as far from the mark as the grasp was from its middle. Here it lands 3.2-3.3 cm
+    beyond that point (on 254c973 as on 92dcea1), over the pick-and-place bench's 3 cm:
+    the cause is not known yet, so this end-to-end test allows 4 cm."""
     client.post("/scene", {"yaml": kitchen_at("table_31")})
     client.post("/mode", {"mode": "pick_and_place"})
-    mark(client, "tv_remote")
+    grasp = mark(client, "tv_remote")["current"]["position"]
+    held_off = np.subtract(obj(client, "tv_remote")["center_base"][:2], grasp[:2])
     client.post("/execute")
     state = client.settled(180)
     assert state["state"] == "awaiting_place", state["message"]
@@ -153,7 +158,13 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
     state = client.settled(180)
     assert state["state"] == "idle" and state["failure"] is None, state["message"]
     placed = obj(client, "tv_remote")
-    assert np.linalg.norm(np.subtract(placed["position_world"][:2], goal[:2])) < 0.05
+    x, y, yaw = state["base_pose"]  # the scooter has not moved: `base` is as at the pick
+    dx, dy = goal[0] - x, goal[1] - y
+    goal_base = np.array(
+        [math.cos(yaw) * dx + math.sin(yaw) * dy, -math.sin(yaw) * dx + math.cos(yaw) * dy]
+    )
+    off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base + held_off))
+    assert off < 0.04, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
     assert placed["upright"] > math.cos(math.radians(15))
     assert abs(placed["position_world"][2] - 0.31) < 0.02  # resting on the table top
 
