@@ -133,17 +133,19 @@ def kitchen_at(surface: str) -> str:
 
 
 def remote_goal() -> list[float]:
-    """World (m): on the 31 cm coffee table, 20 cm along it from where the TV remote lies."""
+    """World (m): on the 31 cm coffee table, 20 cm along it from where the TV remote lies
+    and 5 cm farther from the scooter. Where the remote lies is 10 cm behind the table's
+    front edge: a mark there, with the edge seen a little nearer, was moved back 3.2 cm,
+    as a place moves a mark near the edge (000 section 4.5, `surface.place_target`)."""
     remote = next(o for o in scene_config("kitchen")["objects"] if o["name"] == "tv_remote")
-    return [remote["xy"][0] + 0.2, remote["xy"][1], 0.31]
+    return [remote["xy"][0] + 0.2, remote["xy"][1] + 0.05, 0.31]
 
 
 def test_pick_and_place_on_kitchen(client: Client) -> None:
     """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it. The
     hand brings the point it holds to the mark (004 section 7.3), so the remote's middle
-    lands as far from the mark as the grasp was from its middle. Here it lands 3.2-3.3 cm
-    beyond that point (on 254c973 as on 92dcea1), over the pick-and-place bench's 3 cm:
-    the cause is not known yet, so this end-to-end test allows 4 cm."""
+    lands as far from the mark as the grasp was from its middle: within 3 cm of that, the
+    pick-and-place bench's tolerance."""
     client.post("/scene", {"yaml": kitchen_at("table_31")})
     client.post("/mode", {"mode": "pick_and_place"})
     grasp = mark(client, "tv_remote")["current"]["position"]
@@ -164,7 +166,7 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
         [math.cos(yaw) * dx + math.sin(yaw) * dy, -math.sin(yaw) * dx + math.cos(yaw) * dy]
     )
     off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base + held_off))
-    assert off < 0.04, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
+    assert off < 0.03, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
     assert placed["upright"] > math.cos(math.radians(15))
     assert abs(placed["position_world"][2] - 0.31) < 0.02  # resting on the table top
 
