@@ -135,8 +135,8 @@ def kitchen_at(surface: str) -> str:
 def remote_goal() -> list[float]:
     """World (m): on the 31 cm coffee table, 20 cm along it from where the TV remote lies
     and 5 cm farther from the scooter. Where the remote lies is 10 cm behind the table's
-    front edge: a mark there, with the edge seen a little nearer, was moved back 3.2 cm,
-    as a place moves a mark near the edge (000 section 4.5, `surface.place_target`)."""
+    front edge: a mark there, with the edge seen a little farther in, landed 3.2 cm farther
+    back, as a place moves a mark near the edge (000 section 4.5, `surface.place_target`)."""
     remote = next(o for o in scene_config("kitchen")["objects"] if o["name"] == "tv_remote")
     return [remote["xy"][0] + 0.2, remote["xy"][1] + 0.05, 0.31]
 
