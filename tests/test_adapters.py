@@ -360,9 +360,7 @@ def test_sip_and_puff_picks_and_places_on_kitchen(server: ServeProcess, tmp_path
     out = adapter.text()
     assert "task soft puff: pick and place" in out and "Placed. Ready." in out, out
     placed = obj(server.url, "tv_remote")
-    # The hand brings the point it holds to the mark: the remote's middle lands up to the
-    # grasp's offset from it (2-3 cm here) plus the place's error (tests/test_server.py).
-    assert np.linalg.norm(np.subtract(placed["position_world"][:2], goal[:2])) < 0.06, out
+    assert np.linalg.norm(np.subtract(placed["position_world"][:2], goal[:2])) < 0.05, out
     assert abs(placed["position_world"][2] - 0.31) < 0.02
 
 

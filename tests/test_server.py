@@ -26,6 +26,7 @@ from laserpick.client import API, ApiError, Client
 from laserpick.robot.scenes import load_scene, scene_config
 from laserpick.server.journal import Journal
 from laserpick.server.wire import decode_cloud
+from laserpick.transforms import invert, planar_pose
 
 pytestmark = pytest.mark.timeout(420)
 
@@ -160,11 +161,8 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
     state = client.settled(180)
     assert state["state"] == "idle" and state["failure"] is None, state["message"]
     placed = obj(client, "tv_remote")
-    x, y, yaw = state["base_pose"]  # the scooter has not moved: `base` is as at the pick
-    dx, dy = goal[0] - x, goal[1] - y
-    goal_base = np.array(
-        [math.cos(yaw) * dx + math.sin(yaw) * dy, -math.sin(yaw) * dx + math.cos(yaw) * dy]
-    )
+    # The scooter has not moved: `base` is as at the pick.
+    goal_base = (invert(planar_pose(*state["base_pose"])) @ np.append(goal, 1.0))[:2]
     off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base + held_off))
     assert off < 0.03, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
     assert placed["upright"] > math.cos(math.radians(15))
