@@ -130,7 +130,9 @@ class PerceptionSettings(BaseModel):
             "Inliers a plane needs to be removed, at 004's density: five Structure sensors at"
             " full 640x480 resolution. Ours are the same sensors (640x480, same mounts), fused"
             " at every pixel_stride-th pixel, so segment.py needs 13000 / pixel_stride^2"
-            " (3250 at stride 2). 004 6.1."
+            " (3250 at stride 2). 004 6.1. We count only inliers whose normal faces up"
+            " (within plane_candidate_tilt_deg of vertical): a band through a wall, or through"
+            " object tops that line up, is not a surface."
         ),
     )
     plane_max_removed: float = Field(

@@ -296,3 +296,56 @@ def test_a_floor_filling_the_view_is_found_around_the_mark():
     truth = np.zeros(len(cloud), bool)
     truth[-len(box_pts) :] = True
     assert iou(_mask(seg, len(cloud)), truth) > 0.9
+
+
+def test_object_tops_in_line_are_not_a_surface():
+    """A plane's band cuts through whatever crosses it. Here a bowl's rim and the top of a
+    box 8 cm beside it stand 6 cm above the table, in one band: more points than a plane
+    needs, but only the box's top faces up. That is not a surface. Counted whole, it was the
+    bowl's support, 6 cm above the table, and the rim went with it (the kitchen's bowl on
+    the counter: the gripper closed above the rim)."""
+    rng = np.random.default_rng(0)
+    g = np.arange(-0.3, 0.3, 0.003)
+    x, y = np.meshgrid(g, g)
+    table = np.column_stack([1.5 + x.ravel(), y.ravel(), np.full(x.size, 0.5)])
+    up = np.array([0.0, 0.0, 1.0])
+    # The bowl's wall: a 13 cm ring, 6 cm tall, its points facing out.
+    phi, z = np.meshgrid(np.arange(0, 2 * np.pi, 0.002 / 0.065), np.arange(0.5, 0.56, 0.002))
+    out = np.column_stack([np.cos(phi.ravel()), np.sin(phi.ravel()), np.zeros(phi.size)])
+    ring = np.column_stack([1.5 + 0.065 * out[:, :2], z.ravel()])
+    # A box's 8 x 12 cm top, level with the rim, 8 cm from it.
+    bx, by = np.meshgrid(np.arange(0.0, 0.08, 0.003), np.arange(-0.06, 0.06, 0.003))
+    box = np.column_stack([1.5 + 0.145 + bx.ravel(), by.ravel(), np.full(bx.size, 0.56)])
+    # A wall behind, facing the robot, so that the table is under 70 % of the cloud.
+    wy, wz = np.meshgrid(np.arange(-0.6, 0.6, 0.005), np.arange(0.0, 1.0, 0.005))
+    wall = np.column_stack([np.full(wy.size, 2.5), wy.ravel(), wz.ravel()])
+    pts = np.concatenate([table, ring, box, wall])
+    normals = np.concatenate(
+        [
+            np.tile(up, (len(table), 1)),
+            out,
+            np.tile(up, (len(box), 1)),
+            np.tile([-1.0, 0.0, 0.0], (len(wall), 1)),
+        ]
+    )
+    n = len(pts)
+    cloud = FusedCloud(
+        (pts + rng.normal(0, 0.001, pts.shape)).astype(np.float32),
+        normals.astype(np.float32),
+        np.zeros(n, np.uint8),
+        np.arange(n, dtype=np.int32),
+        ("synthetic",),
+    )
+    settings = SETTINGS.model_copy(update={"plane_min_inliers": 4 * 1500})
+    band = np.abs(pts[:, 2] - 0.56) <= settings.plane_distance
+    in_band_up = np.count_nonzero(band[len(table) :] & (normals[len(table) :, 2] > 0.9))
+    assert in_band_up < min_plane_inliers(settings) < np.count_nonzero(band[len(table) :])
+
+    _, planes = remove_horizontal_planes(cloud, settings)
+    assert [round(p.height, 2) for p in planes] == [0.5]
+    mark = np.array([1.5 + 0.065, 0.0, 0.55], np.float32)  # on the rim's side
+    seg = segment_target(cloud, mark, settings)
+    assert isinstance(seg, Segmentation) and seg.surface is not None
+    assert abs(seg.surface.height - 0.5) < 0.005
+    rim_top = cloud.points[len(table) : len(table) + len(ring)][:, 2].max()
+    assert cloud.points[seg.indices, 2].max() > rim_top - 0.003, "the rim is part of the bowl"
