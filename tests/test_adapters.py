@@ -62,6 +62,7 @@ from laserpick.adapters.sources import (
 )
 from laserpick.client import ApiError, Client
 from laserpick.description.dims import LASER_ORIGIN
+from laserpick.transforms import invert, planar_pose
 
 pytestmark = pytest.mark.timeout(400)
 
@@ -72,13 +73,6 @@ def aim_angles(point_base: list[float]) -> tuple[float, float]:
     """(yaw, pitch) rad that point the laser from its origin at a point in `base`."""
     v = np.subtract(point_base, LASER_ORIGIN)
     return math.atan2(v[1], v[0]), math.atan2(v[2], math.hypot(v[0], v[1]))
-
-
-def world_to_base(p: list[float], base_pose: list[float]) -> list[float]:
-    x, y, yaw = base_pose
-    dx, dy = p[0] - x, p[1] - y
-    c, s = math.cos(yaw), math.sin(yaw)
-    return [c * dx + s * dy, -s * dx + c * dy, p[2]]
 
 
 def prepare(url: str, *, scene: dict[str, Any], mode: str = "pick_and_drop") -> dict[str, Any]:
@@ -329,7 +323,8 @@ def test_sip_and_puff_picks_and_places_on_kitchen(server: ServeProcess, tmp_path
     remote = obj(server.url, "tv_remote")
     goal = remote_goal()
     y1, p1 = aim_angles(remote["center_base"])
-    y2, p2 = aim_angles(world_to_base(goal, state["base_pose"]))
+    base_from_world = invert(planar_pose(*state["base_pose"]))
+    y2, p2 = aim_angles((base_from_world @ np.append(goal, 1.0))[:3])
     y0, p0 = state["laser"]["yaw"], state["laser"]["pitch"]
     rate = 0.4
     s = Script()
