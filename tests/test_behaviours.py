@@ -37,6 +37,7 @@ from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import matrix_from_quat
 
 TABLE_TOP = 0.46  # the isolation scene's table (m)
+TABLE_FRONT = 1.30  # its front edge's x (m, `world`)
 DATA = Path(__file__).parent / "data"
 
 
@@ -107,6 +108,35 @@ def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robo
     T_low[2, 3] = TABLE_TOP + 0.15
     q_high = ik_tcp(T_low, dims.UR5_READY_Q)[0]
     assert b._run(timed(np.stack([robot.joint_state().q, q_high]), b.settings.motion), "") is None
+
+
+def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
+    """The arm holds still with the hand low before the table's front edge, and the user
+    drives at it, the stick held: the protective stop feels the push as it feels a motion
+    pushed back, and halts the scooter with the arm each time it passes its limit. The drive
+    had no such stop: it pressed a held bottle, the gripper and the arm into the 108 cm table
+    at 500 to 1,400 N for seconds (pick-place, seed 1), and here the fingers at 320-780 N."""
+    for _ in range(15):  # back 30 cm, to have the hand low before the table's edge
+        robot.drive(-0.2, 0.0, 0.2)
+        robot.sleep(0.1)
+    robot.sleep(1.0)
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    T = tcp_pose(dims.UR5_READY_Q)
+    T[:3, 3] = [1.45, -0.3, TABLE_TOP - 0.02]  # `base`: under the top, before its edge
+    q = ik_tcp(T, dims.UR5_READY_Q)[0]
+    assert b._run(timed(np.stack([robot.joint_state().q, q]), b.settings.motion), "") is None
+    x0 = robot.base_pose()[0]
+    gap = TABLE_FRONT - (x0 + 1.45)  # m from the TCP to the table's front edge
+    sim = robot.sim
+    pushed = []
+    for _ in range(30):  # 3 s at 0.2 m/s
+        robot.drive(0.2, 0.0, 0.2)
+        robot.sleep(0.1)
+        pushed.append(sum(f for f, _, _ in sim.call(lambda m, d: sim._arm_contacts())))
+    moved = robot.base_pose()[0] - x0
+    assert moved > gap - 0.08 and max(pushed) > 50, "the hand reached the table"
+    assert max(pushed) < 1.2 * dims.UR5_PROTECTIVE_STOP_FORCE, f"pushed {max(pushed):.0f} N"
 
 
 def test_before_a_counter_above_the_ready_hand_the_arm_goes_to_the_high_ready_pose(robot):

@@ -409,6 +409,13 @@ class Simulation:
             except Exception as exc:
                 log.exception("arm control failed")
                 self._halt("failed", f"arm control failed: {exc}")
+        elif why := self._stopped_by_contact(None):
+            # The arm holds still, and the scooter drives it, or what it holds, into
+            # something: the UR5 feels that as it feels a motion pushed back, and the drive
+            # stops with it (a held juice bottle was pressed into a table at up to 1,400 N
+            # for seconds while the scooter turned away from it).
+            log.warning("the scooter and the still arm halted: %s", why)
+            return
         d.ctrl[info.arm_ctrl] = self._q_set
         # Gripper: ramp the finger setpoint at the gripper's speed.
         step = dims.GRIPPER_SPEED / 2 * dt
@@ -438,19 +445,21 @@ class Simulation:
             self._handle._finish(status, message)
         self._motion, self._handle = None, None
 
-    def _stopped_by_contact(self, guard_force: float | None) -> bool:
+    def _stopped_by_contact(self, guard_force: float | None) -> str | None:
         """Stop the motion where the force from outside on the arm passes its guard (N), or
         on any motion the protective stop's limit: the UR5 controller stops every motion it
-        feels pushed back that hard, planned around what it was shown or not."""
+        feels pushed back that hard, planned around what it was shown or not. Returns why it
+        stopped, or None."""
         contacts = self._arm_contacts()
         total = sum(f for f, _, _ in contacts)
+        why = None
         if guard_force is not None and total > guard_force:
-            self._halt("failed", f"unexpected contact: {self._contact_report(contacts)}")
-            return True
-        if total > dims.UR5_PROTECTIVE_STOP_FORCE:
-            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts))
-            return True
-        return False
+            why = f"unexpected contact: {self._contact_report(contacts)}"
+        elif total > dims.UR5_PROTECTIVE_STOP_FORCE:
+            why = PROTECTIVE_STOP + self._contact_report(contacts)
+        if why is not None:
+            self._halt("failed", why)
+        return why
 
     def _halt(self, status: MotionStatus, message: str) -> None:
         """Hold the arm where it is and stop the base, at once."""
