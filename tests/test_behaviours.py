@@ -112,10 +112,11 @@ def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robo
 
 def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
     """The arm holds still with the hand low before the table's front edge, and the user
-    drives at it, the stick held: the protective stop feels the push as it feels a motion
-    pushed back, and halts the scooter with the arm each time it passes its limit. The drive
-    had no such stop: it pressed a held bottle, the gripper and the arm into the 108 cm table
-    at 500 to 1,400 N for seconds (pick-place, seed 1), and here the fingers at 320-780 N."""
+    drives at it, the stick held: the scooter stops each time it pushes the arm harder than
+    the protective stop's limit, and the arm is not bent back. The drive had no such stop: it
+    pressed a held bottle, the gripper and the arm into the 108 cm table at 500 to 1,400 N
+    for seconds (pick-place, seed 1), and here the fingers at 320-780 N. Backing away, which
+    eases the push, is not stopped."""
     for _ in range(15):  # back 30 cm, to have the hand low before the table's edge
         robot.drive(-0.2, 0.0, 0.2)
         robot.sleep(0.1)
@@ -137,6 +138,12 @@ def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
     moved = robot.base_pose()[0] - x0
     assert moved > gap - 0.08 and max(pushed) > 50, "the hand reached the table"
     assert max(pushed) < 1.2 * dims.UR5_PROTECTIVE_STOP_FORCE, f"pushed {max(pushed):.0f} N"
+    assert np.abs(robot.joint_state().q - q).max() < 0.08, "the arm was not bent back"
+    x1 = robot.base_pose()[0]
+    for _ in range(10):
+        robot.drive(-0.2, 0.0, 0.2)
+        robot.sleep(0.1)
+    assert robot.base_pose()[0] < x1 - 0.1, "it backs away from the table"
 
 
 def test_before_a_counter_above_the_ready_hand_the_arm_goes_to_the_high_ready_pose(robot):

@@ -154,6 +154,8 @@ class Simulation:
             self._drive_cmd = np.zeros(2)
             self._drive_deadline = -1.0
             self._drive_now = np.zeros(2)
+            self._rest_push = 0.0  # N on the still arm when the base last stood still
+            self._push_reported = -math.inf  # sim time (s) the last such push was logged
             self.estopped = False
             self._steps = 0
             mujoco.mj_forward(m, d)
@@ -409,13 +411,6 @@ class Simulation:
             except Exception as exc:
                 log.exception("arm control failed")
                 self._halt("failed", f"arm control failed: {exc}")
-        elif why := self._stopped_by_contact(None):
-            # The arm holds still, and the scooter drives it, or what it holds, into
-            # something: the UR5 feels that as it feels a motion pushed back, and the drive
-            # stops with it (a held juice bottle was pressed into a table at up to 1,400 N
-            # for seconds while the scooter turned away from it).
-            log.warning("the scooter and the still arm halted: %s", why)
-            return
         d.ctrl[info.arm_ctrl] = self._q_set
         # Gripper: ramp the finger setpoint at the gripper's speed.
         step = dims.GRIPPER_SPEED / 2 * dt
@@ -426,6 +421,8 @@ class Simulation:
     def _drive_tick(self, dt: float) -> None:
         d, info = self.data, self.info
         want = self._drive_cmd if d.time < self._drive_deadline else np.zeros(2)
+        if self._motion is None and self._drive_pushes_arm(want):
+            return
         limits = np.array([dims.BASE_A_MAX, dims.BASE_ALPHA_MAX]) * dt
         self._drive_now = self._drive_now + np.clip(want - self._drive_now, -limits, limits)
         v, w = self._drive_now
@@ -440,26 +437,46 @@ class Simulation:
         self._motion, self._handle = motion, handle
         self._q_set = self.data.qpos[self.info.arm_qpos].copy()
 
+    def _drive_pushes_arm(self, want: np.ndarray) -> bool:
+        """Whether the scooter, driving (`want`: the command, m/s and rad/s), pushes the
+        still arm or what it holds into something harder than the protective stop's limit,
+        or than the push when the base last stood still, if that was more (an arm resting on
+        a counter may be driven off it). Then the base stops at once, and the arm keeps its
+        setpoint, so a stick held against the push does not bend it back step by step. The
+        UR5 feels such a push as it feels a motion pushed back (`_stopped_by_contact`), and
+        our system stops the scooter with it: without this, a juice bottle in the hand, the
+        gripper and link 2 were pressed into the 108 cm table at 500 to 1,400 N for seconds
+        while the scooter turned away from it."""
+        pushed = sum(f for f, _, _ in self._arm_contacts())
+        if not want.any() and not self._drive_now.any():
+            self._rest_push = pushed
+            return False
+        if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
+            return False
+        if self.data.time - self._push_reported > 1.0:  # once a second, not every step
+            log.warning("the scooter stopped: it pushed the arm (%.0f N)", pushed)
+            self._push_reported = self.data.time
+        self._stop_base()
+        return True
+
     def _end_motion(self, status: MotionStatus, message: str = "") -> None:
         if self._handle is not None:
             self._handle._finish(status, message)
         self._motion, self._handle = None, None
 
-    def _stopped_by_contact(self, guard_force: float | None) -> str | None:
+    def _stopped_by_contact(self, guard_force: float | None) -> bool:
         """Stop the motion where the force from outside on the arm passes its guard (N), or
         on any motion the protective stop's limit: the UR5 controller stops every motion it
-        feels pushed back that hard, planned around what it was shown or not. Returns why it
-        stopped, or None."""
+        feels pushed back that hard, planned around what it was shown or not."""
         contacts = self._arm_contacts()
         total = sum(f for f, _, _ in contacts)
-        why = None
         if guard_force is not None and total > guard_force:
-            why = f"unexpected contact: {self._contact_report(contacts)}"
-        elif total > dims.UR5_PROTECTIVE_STOP_FORCE:
-            why = PROTECTIVE_STOP + self._contact_report(contacts)
-        if why is not None:
-            self._halt("failed", why)
-        return why
+            self._halt("failed", f"unexpected contact: {self._contact_report(contacts)}")
+            return True
+        if total > dims.UR5_PROTECTIVE_STOP_FORCE:
+            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts))
+            return True
+        return False
 
     def _halt(self, status: MotionStatus, message: str) -> None:
         """Hold the arm where it is and stop the base, at once."""
@@ -469,6 +486,11 @@ class Simulation:
         d.ctrl[info.arm_ctrl] = self._q_set
         # The UR5's brakes and the scooter's motor brake: motion stops this step.
         d.qvel[info.arm_dof] = 0.0
+        self._stop_base()
+
+    def _stop_base(self) -> None:
+        """Stop the scooter this step, and drop the drive command."""
+        d, info = self.data, self.info
         d.qvel[info.base_dof] = 0.0
         self._drive_cmd[:] = 0.0
         self._drive_now[:] = 0.0
