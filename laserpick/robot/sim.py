@@ -447,14 +447,15 @@ class Simulation:
         our system stops the scooter with it: without this, a juice bottle in the hand, the
         gripper and link 2 were pressed into the 108 cm table at 500 to 1,400 N for seconds
         while the scooter turned away from it."""
-        pushed = sum(f for f, _, _ in self._arm_contacts())
+        contacts = self._arm_contacts()
+        pushed = sum(f for f, _, _ in contacts)
         if not want.any() and not self._drive_now.any():
             self._rest_push = pushed
             return False
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
             return False
         if self.data.time - self._push_reported > 1.0:  # once a second, not every step
-            log.warning("the scooter stopped: it pushed the arm (%.0f N)", pushed)
+            log.warning("the scooter stopped: %s", self._contact_report(contacts))
             self._push_reported = self.data.time
         self._stop_base()
         return True
