@@ -154,7 +154,7 @@ class Simulation:
             self._drive_cmd = np.zeros(2)
             self._drive_deadline = -1.0
             self._drive_now = np.zeros(2)
-            self._rest_push = 0.0  # N on the still arm when the base last stood still
+            self._rest_push = 0.0  # N on the still arm when the current drive began
             self._push_reported = -math.inf  # sim time (s) the last such push was logged
             self.estopped = False
             self._steps = 0
@@ -447,11 +447,13 @@ class Simulation:
         our system stops the scooter with it: without this, a juice bottle in the hand, the
         gripper and link 2 were pressed into the 108 cm table at 500 to 1,400 N for seconds
         while the scooter turned away from it."""
+        starting = not self._drive_now.any()
+        if starting and not want.any():  # standing still: nothing to watch each step
+            return False
         contacts = self._arm_contacts()
         pushed = sum(f for f, _, _ in contacts)
-        if not want.any() and not self._drive_now.any():
+        if starting:  # the push the drive starts from, the base still standing
             self._rest_push = pushed
-            return False
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
             return False
         if self.data.time - self._push_reported > 1.0:  # once a second, not every step
