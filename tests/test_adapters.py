@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from basket import judge_drop, lost_in_carry
 from serve_process import REPO, ServeProcess, stop_process
-from test_server import kitchen_at, remote_goal
+from test_server import in_base, kitchen_at, remote_goal
 
 from laserpick.adapters.announce import Announcer
 from laserpick.adapters.connection import MAX_NUDGE, Connection
@@ -62,7 +62,6 @@ from laserpick.adapters.sources import (
 )
 from laserpick.client import ApiError, Client
 from laserpick.description.dims import LASER_ORIGIN
-from laserpick.transforms import invert, planar_pose
 
 pytestmark = pytest.mark.timeout(400)
 
@@ -323,8 +322,7 @@ def test_sip_and_puff_picks_and_places_on_kitchen(server: ServeProcess, tmp_path
     remote = obj(server.url, "tv_remote")
     goal = remote_goal()
     y1, p1 = aim_angles(remote["center_base"])
-    base_from_world = invert(planar_pose(*state["base_pose"]))
-    y2, p2 = aim_angles((base_from_world @ np.append(goal, 1.0))[:3])
+    y2, p2 = aim_angles(in_base(goal, state["base_pose"]))
     y0, p0 = state["laser"]["yaw"], state["laser"]["pitch"]
     rate = 0.4
     s = Script()

@@ -142,6 +142,11 @@ def remote_goal() -> list[float]:
     return [remote["xy"][0] + 0.2, remote["xy"][1] + 0.05, 0.31]
 
 
+def in_base(world: list[float], base_pose: list[float]) -> np.ndarray:
+    """A `world` point (m) in `base`, the scooter standing at `base_pose` (x, y, yaw)."""
+    return (invert(planar_pose(*base_pose)) @ np.append(world, 1.0))[:3]
+
+
 def test_pick_and_place_on_kitchen(client: Client) -> None:
     """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it. The
     hand brings the point it holds to the mark (004 section 7.3), so the remote's middle
@@ -162,7 +167,7 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
     assert state["state"] == "idle" and state["failure"] is None, state["message"]
     placed = obj(client, "tv_remote")
     # The scooter has not moved: `base` is as at the pick.
-    goal_base = (invert(planar_pose(*state["base_pose"])) @ np.append(goal, 1.0))[:2]
+    goal_base = in_base(goal, state["base_pose"])[:2]
     off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base + held_off))
     assert off < 0.03, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
     assert placed["upright"] > math.cos(math.radians(15))
