@@ -80,7 +80,7 @@ def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
     outline = Outline((-0.15, 1.30), (-0.68, 0.38))  # the referee's, with the arm stowed
     table, counter = scene.surface("table_73"), scene.surface("counter")
     start, goal = parking_pose(table), parking_pose(counter, 0.3)
-    plan = plan_drive(start, goal, scene.surfaces, outline, reverse_first=0.6)
+    plan = plan_drive(start, goal, scene.surfaces, outline, 0.6, parked_at=("counter",))
     assert plan is not None
     back, waypoints = plan
     assert back >= 0.6
@@ -105,6 +105,18 @@ def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
     # The user's old way, straight from the table to 0.8 m before the counter, hit the table.
     straight = _leg(start[:2] - 0.6 * np.array([1.0, 0.0]), waypoints[-1], 0.0)
     assert _clearance([table], _at(straight, outline.points())).min() < DRIVE_MARGIN
+
+
+def test_the_user_parks_over_only_what_they_work_at() -> None:
+    """Parked at the 31 cm table, the arm stands over it. That is where the user parks to
+    work at the table; to work at anything else (an object on the floor before it) the same
+    pose would press the arm into the table, and no way leads there."""
+    scene = load_scene("kitchen", seed=1)
+    outline = Outline((-0.15, 1.30), (-0.68, 0.38))  # the referee's, with the arm stowed
+    start, goal = parking_pose(scene.surface("table_73")), parking_pose(scene.surface("table_31"))
+    assert plan_drive(start, goal, scene.surfaces, outline, 0.6, parked_at=("table_31",))
+    assert plan_drive(start, goal, scene.surfaces, outline, 0.6, parked_at=()) is None
+    assert plan_drive(start, goal, scene.surfaces, outline, 0.6, parked_at=("table_73",)) is None
 
 
 def test_the_user_parks_at_a_floor_object_from_a_side_with_nothing_under_the_scooter() -> None:

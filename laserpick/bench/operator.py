@@ -10,7 +10,7 @@ it only to look at the world the way a person would.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -318,32 +318,14 @@ class Outline:
         )
 
 
-def drive_to(
-    driver: Driver,
-    goal: np.ndarray,
-    *,
-    reverse_first: float = 0.0,
-    around: Sequence[Surface | Footprint] = (),
-    outline: Outline | None = None,
-) -> bool:
-    """Drive like a careful user: back out `reverse_first` m, drive to a point 0.8 m in
-    front of the goal (APPROACH_DISTANCES), turn to face the goal and creep in. Returns
-    whether the scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw in `world`).
-
-    Given the furniture (`around`) and the scooter's `outline`, the user first looks for a
-    way that keeps the whole scooter DRIVE_MARGIN from the furniture (`plan_drive`): backing
-    out farther, turning farther out, or stopping on the way to turn, where needed. Finding
-    none, they do not drive, and it returns False."""
+def drive_to(driver: Driver, goal: np.ndarray, *, reverse_first: float = 0.0) -> bool:
+    """Drive like a careful user where nothing is in the way: back out `reverse_first` m,
+    drive to a point APPROACH_DISTANCES[0] in front of the goal, turn to face the goal and
+    creep in. Returns whether the scooter ended within 3 cm and 2 deg of `goal` (x, y, yaw
+    in `world`). Among furniture, `plan_drive` finds the way and `follow` drives it."""
     goal = np.asarray(goal, float)
-    waypoints = [
-        goal[:2] - APPROACH_DISTANCES[0] * np.array([math.cos(goal[2]), math.sin(goal[2])])
-    ]
-    if around and outline is not None:
-        plan = plan_drive(driver.base_pose(), goal, around, outline, reverse_first)
-        if plan is None:
-            return False
-        reverse_first, waypoints = plan
-    return follow(driver, goal, reverse_first, waypoints)
+    facing = np.array([math.cos(goal[2]), math.sin(goal[2])])
+    return follow(driver, goal, reverse_first, [goal[:2] - APPROACH_DISTANCES[0] * facing])
 
 
 def follow(
@@ -506,17 +488,20 @@ def plan_drive(
     surfaces: Sequence[Surface | Footprint],
     outline: Outline,
     reverse_first: float = 0.0,
+    parked_at: Collection[str] = (),
 ) -> tuple[float, list[np.ndarray]] | None:
     """A way from `start` to park at `goal` (x, y, yaw in `world`) that keeps the whole
-    scooter DRIVE_MARGIN from every surface, driven as `drive_to` drives: back out, turn on
+    scooter DRIVE_MARGIN from every surface, driven as `follow` drives: back out, turn on
     the spot toward the next point and drive there, ..., turn to the goal's heading before
     it and creep in. Returns (how far to back out (m), the points to drive through (m,
     `world` xy), the last one APPROACH_DISTANCES before the goal), or None.
 
     Tried in order: backing out `reverse_first` plus each of REVERSE_STEPS; each approach
     distance; straight, then through one point of a VIA_SPACING grid, nearest first. The
-    moves that leave the start and that reach the goal may touch the surfaces the scooter
-    touches there: it is parked at them."""
+    moves that leave the start may touch what the scooter touches there: it is parked at
+    it. Creeping in to the goal may touch only what is named in `parked_at`, what the user
+    parks to work at (a table the arm reaches over, an object on the floor before the
+    arm); anything else within DRIVE_MARGIN of the goal makes it no place to park."""
     start, goal = np.asarray(start, float), np.asarray(goal, float)
 
     def clear(poses: np.ndarray, exempt: frozenset[str] = frozenset()) -> bool:
@@ -526,7 +511,7 @@ def plan_drive(
     def touching(pose: np.ndarray) -> frozenset[str]:
         return frozenset(s.name for s in surfaces if _gap(pose[None], [s], outline) < DRIVE_MARGIN)
 
-    at_start, at_goal = touching(start), touching(goal)
+    at_start, at_goal = touching(start), frozenset(parked_at)
     facing = np.array([math.cos(goal[2]), math.sin(goal[2])])
 
     def go(xy: np.ndarray, yaw: float, to: np.ndarray) -> tuple[np.ndarray, float]:
@@ -539,6 +524,11 @@ def plan_drive(
         arrive = np.vstack([_turn(approach, yaw, goal[2]), _leg(approach, goal[:2], goal[2])])
         return clear(arrive, at_goal)
 
+    # Where the creep in is blocked whatever way leads to it, no way is worth searching.
+    approaches = [goal[:2] - d * facing for d in APPROACH_DISTANCES]
+    approaches = [a for a in approaches if clear(_leg(a, goal[:2], goal[2]), at_goal)]
+    if not approaches:
+        return None
     lo = np.min([s.xy for s in surfaces], axis=0) - 1.0
     hi = np.max([s.xy for s in surfaces], axis=0) + 1.0
     grid = np.mgrid[lo[0] : hi[0] : VIA_SPACING, lo[1] : hi[1] : VIA_SPACING].reshape(2, -1).T
@@ -549,7 +539,7 @@ def plan_drive(
         if back > 0 and not clear(_leg(start[:2], out, start[2]), at_start):
             continue
         leaving = at_start if back == 0 else frozenset()
-        for approach in (goal[:2] - d * facing for d in APPROACH_DISTANCES):
+        for approach in approaches:
             moves, h = go(out, start[2], approach)
             if clear(moves, leaving) and arrive_clear(approach, h):
                 return back, [approach]

@@ -332,7 +332,8 @@ def _go_to_object(op: ScriptedOperator, scene: Scene, instance: str, back: float
     surface = scene.surface(placement.surface)
     level = surface.levels[placement.level]
     local_x, local_y = surface.to_local(op.referee.world_position(instance)[:2])
-    return _park(op, scene, surface, float(local_x), float(local_y), level, back=back)
+    works_at = instance if surface.kind == "floor" else surface.name
+    return _park(op, scene, surface, float(local_x), float(local_y), level, works_at, back=back)
 
 
 def _park(
@@ -342,24 +343,28 @@ def _park(
     local_x: float,
     local_y: float,
     level: float,
+    works_at: str | None,
     outline: Outline | None = None,
     back: float = 0.0,
 ) -> bool:
     """Drive to work at the spot (local x, y: m in the surface's frame; level: its height),
-    `back` m farther back than at first, and say whether the user parked there. A floor may
-    be driven onto from any side: the user tries each of FLOOR_TURNS in turn until one
-    leads there."""
+    `back` m farther back than at first, and say whether the user parked there. Parked, the
+    scooter may reach over only `works_at`: the surface, or the object on a floor it picks
+    (None: a free spot on a floor). A floor may be driven onto from any side: the user
+    tries each of FLOOR_TURNS in turn until one parks clear of everything else and leads
+    there."""
     turns = FLOOR_TURNS if surface.kind == "floor" else (0.0,)
     outline = outline or op.referee.outline()
     around = _around(op, scene)
+    parked_at = () if works_at is None else (works_at,)
+    others = [a for a in around if a.name not in parked_at]
     for turn in turns:
         goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn, back=back)
         if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
             return True
-        last = turn == turns[-1]
-        if not last and not parked_clear(goal, around, outline):
+        if not parked_clear(goal, others, outline):
             continue
-        plan = plan_drive(op.base_pose(), goal, around, outline, 0.6)
+        plan = plan_drive(op.base_pose(), goal, around, outline, 0.6, parked_at)
         if plan is not None:
             return follow(op, goal, *plan)
     return False
@@ -563,7 +568,8 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         local_y, spot_world = spot
         local_x = float(dest.to_local(spot_world[:2])[0])
         outline = op.referee.outline()  # the object in hand included
-        if _park(op, scene, dest, local_x, local_y, spot_world[2], outline):
+        works_at = None if dest.kind == "floor" else dest.name
+        if _park(op, scene, dest, local_x, local_y, spot_world[2], works_at, outline):
             break
         failure = Failure("precondition", f"the user could not park at {dest.name}")
     else:
