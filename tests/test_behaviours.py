@@ -33,6 +33,7 @@ from laserpick.pipeline.selection import group, score
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.scenes import load_scene
+from laserpick.robot.sim import DRIVE_STOP
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.transforms import matrix_from_quat
 
@@ -139,11 +140,14 @@ def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
     assert moved > gap - 0.08 and max(pushed) > 50, "the hand reached the table"
     assert max(pushed) < 1.2 * dims.UR5_PROTECTIVE_STOP_FORCE, f"pushed {max(pushed):.0f} N"
     assert np.abs(robot.joint_state().q - q).max() < 0.08, "the arm was not bent back"
+    said = sim.snapshot().drive_stop  # what the consoles show
+    assert said.startswith(DRIVE_STOP) and " met " in said, said
     x1 = robot.base_pose()[0]
     for _ in range(10):
         robot.drive(-0.2, 0.0, 0.2)
         robot.sleep(0.1)
     assert robot.base_pose()[0] < x1 - 0.1, "it backs away from the table"
+    assert sim.snapshot().drive_stop == "", "driven freely, the notice is taken down"
 
 
 def test_before_a_counter_above_the_ready_hand_the_arm_goes_to_the_high_ready_pose(robot):

@@ -584,3 +584,33 @@ def test_esc_stops_and_the_gamepad_and_keys_drive(browser, server: ServeProcess)
         wait_state(server, lambda s: not s["estopped"], 5)
     finally:
         close_page(page)
+
+
+def test_the_page_says_why_the_scooter_stopped(browser, server: ServeProcess) -> None:
+    """Driven forward, the stowed arm's base meets the isolation table 10 cm on and the
+    scooter stops itself: the page's status line says so (read out, and alerted once), with
+    what met what, and takes it down once the scooter has backed away."""
+    fresh_scene(server)
+    page = open_page(browser, server)
+    said = "document.getElementById('status').textContent.includes('The scooter stopped')"
+    try:
+        api = observer(server)
+        tab_to(page, "Forward")
+        page.keyboard.down("ArrowUp")
+        try:
+            state = wait_state(server, lambda s: s["drive_stop"] is not None, 10)
+        finally:
+            page.keyboard.up("ArrowUp")
+        assert "met surface/table" in state["drive_stop"]
+        page.wait_for_function(said)
+        tab_to(page, "Back")
+        x0 = api.state()["base_pose"][0]
+        page.keyboard.down("ArrowDown")
+        page.wait_for_timeout(1200)
+        page.keyboard.up("ArrowDown")
+        state = wait_state(server, lambda s: s["drive_stop"] is None, 5)
+        assert state["base_pose"][0] < x0 - 0.1
+        page.wait_for_function(f"!{said}")
+    finally:
+        close_page(page)
+        fresh_scene(server)

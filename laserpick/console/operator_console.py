@@ -591,7 +591,10 @@ class OperatorConsole:
             else f" · controlled by {lease['holder']}"
         )
         estop = " · **E-STOP LATCHED**" if status["estopped"] else ""
-        text = f"**{status['state'].replace('_', ' ')}** · {status['message']}{estop}{control}"
+        stop = f" · **{status['drive_stop']}**" if status["drive_stop"] else ""
+        text = (
+            f"**{status['state'].replace('_', ' ')}** · {status['message']}{estop}{stop}{control}"
+        )
         if self._status is not None and self._status.content != text:
             self._status.content = text
         timings = status["timings"]

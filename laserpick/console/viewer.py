@@ -329,11 +329,13 @@ class SceneViewer:
         return (shift > POSE_STEP_M) | (2.0 * np.arccos(dot) > POSE_STEP_RAD)
 
     def status_text(self, snap: Snapshot | None = None) -> str:
-        """The status line: sim time (s), real-time factor, run state and e-stop state."""
+        """The status line: sim time (s), real-time factor, run state and e-stop state, and
+        why the scooter stopped itself, while it says so."""
         snap = snap if snap is not None else self.sim.snapshot()
         state = "paused" if self.sim.paused else "running"
         estop = "**E-STOP LATCHED**" if snap.estopped else "e-stop clear"
-        return f"sim time {snap.time:8.2f} s · RTF {snap.rtf:4.2f} · {state} · {estop}"
+        stop = f" · **{snap.drive_stop}**" if snap.drive_stop else ""
+        return f"sim time {snap.time:8.2f} s · RTF {snap.rtf:4.2f} · {state} · {estop}{stop}"
 
     # --- building -------------------------------------------------------------------------------
 

@@ -40,6 +40,11 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 _CHUNK_STEPS = 10
 #: How a motion's message begins when a protective stop ended it.
 PROTECTIVE_STOP = "protective stop: "
+#: What a console says when the scooter stops itself, before what the arm met.
+DRIVE_STOP = "The scooter stopped: driving pushed the arm into something. Drive back to free it ("
+#: s of driving without being stopped again before that notice is taken down: the stick held
+#: against the push stops the scooter every few steps, and the notice must not flicker.
+DRIVE_STOP_CLEARS = 0.5
 
 
 class MotionHandle:
@@ -88,6 +93,9 @@ class Snapshot:
     holding: bool
     estopped: bool
     moving: bool  #: an arm motion is in progress
+    #: Why the scooter last stopped itself while driving (it pushed the still arm into
+    #: something), until it has driven freely for DRIVE_STOP_CLEARS; "" otherwise.
+    drive_stop: str
     rtf: float  #: measured real-time factor of the loop (sim seconds per wall second)
 
 
@@ -156,6 +164,8 @@ class Simulation:
             self._drive_now = np.zeros(2)
             self._rest_push = 0.0  # N on the still arm when the current drive began
             self._push_reported = -math.inf  # sim time (s) the last such push was logged
+            self._drive_stop = ""  # why the scooter last stopped itself, until it drives on
+            self._drive_stopped_at = -math.inf  # sim time (s) of that stop
             self.estopped = False
             self._steps = 0
             mujoco.mj_forward(m, d)
@@ -423,6 +433,8 @@ class Simulation:
         want = self._drive_cmd if d.time < self._drive_deadline else np.zeros(2)
         if self._motion is None and self._drive_pushes_arm(want):
             return
+        if self._drive_stop and want.any() and d.time - self._drive_stopped_at > DRIVE_STOP_CLEARS:
+            self._drive_stop = ""
         limits = np.array([dims.BASE_A_MAX, dims.BASE_ALPHA_MAX]) * dt
         self._drive_now = self._drive_now + np.clip(want - self._drive_now, -limits, limits)
         v, w = self._drive_now
@@ -456,9 +468,11 @@ class Simulation:
             self._rest_push = pushed
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
             return False
+        self._drive_stop = f"{DRIVE_STOP}{self._contact_report(contacts)})."
         if self.data.time - self._push_reported > 1.0:  # once a second, not every step
-            log.warning("the scooter stopped: %s", self._contact_report(contacts))
+            log.warning(self._drive_stop)
             self._push_reported = self.data.time
+        self._drive_stopped_at = self.data.time
         self._stop_base()
         return True
 
@@ -584,6 +598,7 @@ class Simulation:
             and force > dims.GRIPPER_HOLD_FORCE,
             estopped=self.estopped,
             moving=self._handle is not None,
+            drive_stop=self._drive_stop,
             rtf=self._rtf,
         )
         self._snap = snap

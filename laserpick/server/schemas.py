@@ -229,6 +229,10 @@ class Status(BaseModel):
     selection: str
     strategy: str
     estopped: bool
+    drive_stop: str | None = Field(
+        description="Why the scooter stopped itself while driving (it pushed the still arm "
+        "into something), until it drives freely again."
+    )
     sim_time: float
     rtf: float
     joints: JointStatus

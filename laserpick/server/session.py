@@ -1103,6 +1103,7 @@ class Session:
                 "selection": self.selection,
                 "strategy": self.strategy,
                 "estopped": bool(snap.estopped),
+                "drive_stop": snap.drive_stop or None,
                 "sim_time": round(float(snap.time), 4),
                 "rtf": round(float(snap.rtf), 3),
                 "joints": {"q": _vec(snap.arm_q), "qd": _vec(snap.arm_qd)},

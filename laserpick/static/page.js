@@ -311,12 +311,13 @@ function scheduleRender() {
   if (!renderTimer) renderTimer = setTimeout(() => { renderTimer = null; render(); }, 100);
 }
 
-const seen = { status: "", failure: "", estopped: false, projector: "" };
+const seen = { status: "", failure: "", estopped: false, driveStop: "", projector: "" };
 let projectorN = 0;
 
 function statusText(s) {
   const parts = [];
   if (s.estopped && !s.message.includes("E-STOP")) parts.push("E-STOP latched");
+  if (s.drive_stop) parts.push(s.drive_stop);
   const d = s.grasps && s.grasps.describe;
   if (d && !s.message.includes(d)) parts.push(d);
   parts.push(s.message);
@@ -341,6 +342,8 @@ function render() {
   seen.failure = failure;
   if (s.estopped && !seen.estopped) alertText("E-STOP latched: motion is halted until Reset stop.");
   seen.estopped = s.estopped;
+  if (s.drive_stop && s.drive_stop !== seen.driveStop) alertText(s.drive_stop);
+  seen.driveStop = s.drive_stop || "";
 
   renderAvailability(s);
   renderLease();
