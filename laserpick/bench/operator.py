@@ -256,14 +256,16 @@ def parking_pose(
     local_x: float | None = None,
     turn: float = 0.0,
     back: float = 0.0,
+    across: float = 0.0,
 ) -> np.ndarray:
     """Where the user parks to work on `surface` at height `level` (m; default its lowest
     level): facing it, its front edge PARK_EDGE ahead of the rear axle (PARK_EDGE_HIGH when
     the level is above the arm's shoulder) and the spot `local_y` (m, the surface's frame)
     in front of the arm. On a floor, with the spot's `local_x` (m) given, the spot itself
     PARK_FLOOR_REACH ahead instead, the scooter facing the floor's +x turned by `turn`
-    (rad): a floor may be driven onto from any side. `back` (m): that much farther back.
-    Returns (x, y, yaw) in `world` (m, rad)."""
+    (rad): a floor may be driven onto from any side. `back` (m): that much farther back;
+    `across` (m): the spot that much to the left of straight before the arm. Returns
+    (x, y, yaw) in `world` (m, rad)."""
     level = surface.levels[0] if level is None else level
     edge = PARK_EDGE_HIGH if level > dims.ARM_MOUNT_POS[2] + dims.UR5_D[0] else PARK_EDGE
     c, s = math.cos(surface.yaw), math.sin(surface.yaw)
@@ -277,7 +279,7 @@ def parking_pose(
         [c * spot_local[0] - s * spot_local[1], s * spot_local[0] + c * spot_local[1]]
     )
     c, s = math.cos(yaw), math.sin(yaw)
-    reach = np.array([ahead, dims.ARM_MOUNT_POS[1]])
+    reach = np.array([ahead, dims.ARM_MOUNT_POS[1] + across])
     origin = spot - np.array([c * reach[0] - s * reach[1], s * reach[0] + c * reach[1]])
     return np.array([origin[0], origin[1], yaw])
 

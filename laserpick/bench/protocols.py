@@ -88,6 +88,11 @@ NO_PARKING = "the user could not park in front of it"
 #: 36 cm from the plush toy, had no heading the user could park at and drive to (each of
 #: three pick-place trials lost it).
 FLOOR_TURNS = tuple(math.radians(a) for a in sorted(range(-165, 195, 15), key=abs))
+#: m across (to the arm's left) the user lets an object on a floor lie from straight before
+#: the arm, in the order tried, where no heading parks with it straight before the arm: the
+#: tissue packet between the counter, the plush toy and a bowl set down beside them had a
+#: clear way in only 10-20 cm to a side.
+FLOOR_ACROSS = (0.0, 0.1, -0.1, 0.2, -0.2)
 #: A placed object counts as upright when its up axis is tilted under this (rad) from how it
 #: stood before, and as on target within this distance (m) of the mark plus its offset.
 UPRIGHT_TILT = math.radians(15.0)
@@ -354,15 +359,18 @@ def _park(
     `back` m farther back than at first, and say whether the user parked there. Parked, the
     scooter may reach over only `works_at`: the surface, or the object on a floor it picks
     (None: a free spot on a floor). A floor may be driven onto from any side: the user
-    tries each of FLOOR_TURNS in turn until one parks clear of everything else and leads
-    there."""
-    turns = FLOOR_TURNS if surface.kind == "floor" else (0.0,)
+    tries each of FLOOR_TURNS, the spot straight before the arm and then a little to a side
+    (FLOOR_ACROSS), until one parks clear of everything else and leads there."""
+    floor = surface.kind == "floor"
+    ways = itertools.product(FLOOR_ACROSS, FLOOR_TURNS) if floor else [(0.0, 0.0)]
     outline = outline or op.referee.outline()
     around = _around(op, scene)
     parked_at = () if works_at is None else (works_at,)
     others = [a for a in around if a.name not in parked_at]
-    for turn in turns:
-        goal = parking_pose(surface, local_y, level, local_x=local_x, turn=turn, back=back)
+    for across, turn in ways:
+        goal = parking_pose(
+            surface, local_y, level, local_x=local_x, turn=turn, back=back, across=across
+        )
         if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
             return True
         if not parked_clear(goal, others, outline):
