@@ -119,6 +119,20 @@ def test_the_user_parks_over_only_what_they_work_at() -> None:
     assert plan_drive(start, goal, scene.surfaces, outline, 0.6, parked_at=("table_73",)) is None
 
 
+def test_a_turn_near_half_a_turn_is_planned_clear_either_way() -> None:
+    """Planned as 179.6 deg to the left at the high table, the turn went to the right from
+    where the scooter stood (a few degrees off), and link 2 met the table: a turn that
+    close to half a turn is checked all the way round; a smaller one the short way only."""
+
+    def passes(yaw0: float, yaw1: float, heading_deg: float) -> bool:
+        """Whether the turn's poses come within 5 deg of the heading."""
+        yaws = _turn(np.zeros(2), yaw0, yaw1)[:, 2]
+        return bool(np.any(np.cos(yaws - math.radians(heading_deg)) > math.cos(math.radians(5))))
+
+    assert passes(0.6876, -2.4601, 90) and passes(0.6876, -2.4601, -90)
+    assert passes(0.0, math.pi / 2, 45) and not passes(0.0, math.pi / 2, -45)
+
+
 def test_the_user_parks_at_a_floor_object_from_a_side_with_nothing_under_the_scooter() -> None:
     """Facing the kitchen floor's +x, the tissue packet 1.45 m ahead puts the plush toy
     under the scooter: wholly inside its outline, which the outline's edges alone never

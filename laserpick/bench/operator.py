@@ -53,6 +53,10 @@ REVERSE_STEPS = (0.0, 0.4, 0.8, 1.2, 1.6)
 #: m before the parking spot where the user turns to face it and creeps in: the first that
 #: leaves room.
 APPROACH_DISTANCES = (0.8, 1.2)
+#: rad. A planned turn on the spot this close to half a turn may go either way: planned at
+#: the high table as 179.6 deg to the left, it went to the right from where the scooter
+#: stood, and link 2 met the table at up to 2,000 N.
+TURN_EITHER_WAY = math.radians(20.0)
 #: rad. Off its heading by more than this, the user stops and turns on the spot: driving
 #: while turning hard swings the front wide.
 GO_ALIGNED = math.radians(20.0)
@@ -474,8 +478,12 @@ def _leg(a: np.ndarray, b: np.ndarray, yaw: float, step: float = 0.05) -> np.nda
 
 
 def _turn(xy: np.ndarray, yaw0: float, yaw1: float, step: float = math.radians(5)) -> np.ndarray:
-    """Poses (K x 3) of a turn on the spot at xy from yaw0 to yaw1, the short way round."""
+    """Poses (K x 3) of a turn on the spot at xy from yaw0 to yaw1, the short way round; a
+    turn within TURN_EITHER_WAY of half a turn, all the way round: the scooter arrives a few
+    degrees off the heading planned, and turns the short way from where it is."""
     turn = _wrap(yaw1 - yaw0)
+    if abs(turn) > math.pi - TURN_EITHER_WAY:
+        turn = 2 * math.pi
     n = max(2, int(abs(turn) / step) + 1)
     return np.c_[np.tile(xy, (n, 1)), yaw0 + np.linspace(0.0, turn, n)]
 
