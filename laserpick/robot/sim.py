@@ -40,8 +40,8 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 _CHUNK_STEPS = 10
 #: How a motion's message begins when a protective stop ended it.
 PROTECTIVE_STOP = "protective stop: "
-#: What a console says when the scooter stops itself, before what the arm met.
-DRIVE_STOP = "The scooter stopped: driving pushed the arm into something. Drive back to free it ("
+#: What a console says when the scooter stops itself; what the arm met follows.
+DRIVE_STOP = "The scooter stopped: driving pushed the arm into something. Drive back to free it"
 #: s of driving without being stopped again before that notice is taken down: the stick held
 #: against the push stops the scooter every few steps, and the notice must not flicker.
 DRIVE_STOP_CLEARS = 0.5
@@ -468,7 +468,7 @@ class Simulation:
             self._rest_push = pushed
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
             return False
-        self._drive_stop = f"{DRIVE_STOP}{self._contact_report(contacts)})."
+        self._drive_stop = f"{DRIVE_STOP} ({self._contact_report(contacts)})."
         if self.data.time - self._push_reported > 1.0:  # once a second, not every step
             log.warning(self._drive_stop)
             self._push_reported = self.data.time
