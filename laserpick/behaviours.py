@@ -686,8 +686,9 @@ class Behaviours:
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
         hand opens and leaves it (drawn back along its approach from the side, else
-        straight up), and the arm stows around the object where it now stands. Nothing felt
-        by `place_below` under the rest: the hand keeps it.
+        straight up), and the arm stows around the object where it now stands. Felt more
+        than `place_above` early, it is something on the surface: the hand keeps the object
+        and rises. Nothing felt by `place_below` under the rest: the hand keeps it.
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -730,6 +731,17 @@ class Behaviours:
             )
         if "unexpected contact" not in failure.message:
             return Outcome(failure)
+        # How far above the rest (T_above is approach_distance above it) the descent stopped.
+        early = float(tcp_pose(self._q())[2, 3] - T_above[2, 3] + s.approach_distance)
+        if early > s.place_above:
+            self._rise_straight(T_above, "rising from what it met")
+            return Outcome(
+                Failure(
+                    "execute",
+                    f"The object met something {early * 100:.0f} cm above the surface there,"
+                    " so I kept it. Mark another spot.",
+                )
+            )
         # The guard stop is the surface met: let go there, with no drop to roll from.
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)

@@ -554,6 +554,16 @@ class MotionSettings(BaseModel):
         " 4.5). Met nowhere, the place failed and the hand keeps the object. Ours: a"
         " release 1 cm above the rest let a can lying on its side roll 3 cm off its mark.",
     )
+    place_above: float = Field(
+        0.06,
+        gt=0,
+        description="How far (m) above the computed resting pose a place's descent may meet"
+        " something and still take it for the surface, and let go: an object that slid"
+        " down in the pads meets the surface early (a cereal box slid 3.6 cm). Met higher,"
+        " it is something on the surface the cameras missed, and the hand keeps the object"
+        " and rises. Ours: a plush toy let go on a glass cup's rim, 10 cm above the"
+        " counter, fell and landed upside down.",
+    )
     place_contact_force: float = Field(
         10.0,
         gt=0,

@@ -525,6 +525,23 @@ def test_a_surface_not_felt_where_it_was_seen_keeps_the_object(robot):
     assert referee.object_points("mug_1", frame="world")[:, 2].min() > TABLE_TOP + 0.005
 
 
+def test_something_met_well_above_the_surface_keeps_the_object(robot):
+    """The cameras put the table 8 cm lower than it is, as they miss a glass cup standing on
+    the spot: the descent meets it 8 cm above where the object should touch, so the hand
+    keeps the object and rises rather than letting it fall from there (a plush toy let go on
+    a glass cup's rim fell 10 cm and landed upside down)."""
+    b, referee = _pick(robot, "mug_1")
+    assert b.tuck().ok
+    cloud = fuse(robot.capture())
+    lowered = dataclasses.replace(cloud, points=cloud.points - np.float32([0.0, 0.0, 0.08]))
+    out = b.place(lowered, np.array([1.45, -0.55, TABLE_TOP - 0.08]))
+    assert out.failure is not None and out.failure.kind == "execute", out.failure
+    assert "met something 8 cm above the surface" in out.failure.message
+    assert robot.gripper_state().holding and b.held is not None
+    # Back where the descent began, 10 cm above the (wrongly seen) rest: 2 cm up here.
+    assert referee.object_points("mug_1", frame="world")[:, 2].min() > TABLE_TOP + 0.015
+
+
 def _box_points(size: tuple[float, float, float], step: float = 0.01) -> np.ndarray:
     """Points (m) filling a box of `size` whose top face's middle is the origin, reaching
     down along +z: a box held at its top by a downward hand, in the TCP frame."""

@@ -355,13 +355,14 @@ def test_a_grasps_lever_is_its_objects_weight_arm_about_the_line_between_the_fin
     assert lever(upright, np.array([0.05, 0.05, 0.0])) == pytest.approx(0.0)
 
 
-def test_choosing_by_hand_the_user_holds_a_remote_across_its_middle(tmp_path: Path) -> None:
+def test_choosing_by_hand_the_user_holds_across_the_middle_and_toggles_on(tmp_path: Path) -> None:
     """A TV remote lying across the table, its weight 4 cm toward one end (where its
     batteries are): the best clusters hold it off its weight, where it would swing in the
     pads; the user steps past them to the first that holds it across its weight, as a
     person who knows the object would. The simulated remote is uniform, so the test hands
     the user that centre of mass: since G_b is the hand's bottom (selection.hand_bottom), the
-    system itself ranks a grasp across the uniform remote's middle first."""
+    system itself ranks a grasp across the uniform remote's middle first. Told that grasp
+    failed to plan, the user passes its cluster by the next time."""
     scene = tmp_path / "remote.yaml"
     scene.write_text(
         "name: remote\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
@@ -390,6 +391,13 @@ def test_choosing_by_hand_the_user_holds_a_remote_across_its_middle(tmp_path: Pa
         chosen = s.status()["grasps"]["cluster"]
         assert levers[chosen] <= LEVER_MAX
         assert all(x > LEVER_MAX for x in levers[:chosen])
+        # That grasp failed to plan: on the next try the user toggles past its cluster.
+        op.saw_unplanned("remote", np.asarray(s.status()["current"]["position"]))
+        op.choose("remote", before, centre)
+        again = s.status()["grasps"]["cluster"]
+        assert again != chosen
+        balanced = [k for k, x in enumerate(levers) if x <= LEVER_MAX and k != chosen]
+        assert again == (balanced[0] if balanced else 0)
 
 
 def test_the_helper_empties_the_basket_of_any_object_after_an_attempt() -> None:

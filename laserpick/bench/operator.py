@@ -112,6 +112,10 @@ class Referee:
         """A `world` point (m) in `base` now."""
         return (self._T_base_world() @ np.append(world, 1.0))[:3]
 
+    def to_world(self, base: np.ndarray) -> np.ndarray:
+        """A `base` point (m) in `world` now."""
+        return (invert(self._T_base_world()) @ np.append(base, 1.0))[:3]
+
     def position(self, instance: str) -> np.ndarray:
         """The object's origin in `base` (m)."""
         return (self._T_base_world() @ np.append(self.world_position(instance), 1.0))[:3]

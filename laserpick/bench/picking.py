@@ -52,6 +52,10 @@ JOB_TIMEOUT = 600.0
 #: object held farther from its centre of mass, across the line between the fingers, swings
 #: about that line in the pads (a TV remote held near one end was set down on its side).
 LEVER_MAX = 0.02
+#: How near (m) a cluster's best grasp must lie to one the user saw fail to plan for them to
+#: take it for the same and pass it by: half 004's cluster bound (section 7.2). Neighbouring
+#: clusters' best grasps along a remote lay 1.6-3 cm apart.
+UNPLANNED_NEAR = 0.01
 #: The session's progress messages at the moment the hand lets go of the object.
 RELEASED = frozenset({"Released into the basket.", "Placed."})
 
@@ -130,6 +134,9 @@ class ScriptedOperator:
         self.actor = BENCH
         self.referee = Referee(session.robot)
         self._tasks = 0
+        #: Per object, where (m, `world`) grasps the user chose failed to plan: on their next
+        #: try they toggle past them, as a person who saw "none could be planned" would.
+        self._unplanned: dict[str, list[np.ndarray]] = {}
         self._events: list[dict[str, Any]] = []
         # Stamped with the simulated time as they happen (listeners run on the emitting thread).
         session.on_event(lambda e: self._events.append({**e, "sim_time": self._sim_time()}))
@@ -234,21 +241,33 @@ class ScriptedOperator:
         first whose best grasp closes on `instance` across its middle (a `lever` of at most
         LEVER_MAX about its centre of mass `centre`, m, `base`), as a person who sees the
         object would hold it; else to the first on `instance` at all; none such: back to the
-        system's choice."""
+        system's choice. Clusters where a choice failed to plan before are passed by while
+        another on `instance` is left: a cluster of one grasp that cannot be planned ended a
+        pick-place try on a shelf, and the next try chose it again."""
         s = self.session
-        first_on = None
+        failed = self._unplanned.get(instance, [])
+        best: tuple[tuple[bool, bool], int] | None = None  # (tried, off balance), cluster
         for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
             pose = np.asarray(s.status()["current"]["pose"])
             if self.referee.object_at(pose[:3, 3], before) != instance:
                 continue
-            if lever(pose, centre) <= LEVER_MAX:
+            at = self.referee.to_world(pose[:3, 3])
+            tried = any(np.linalg.norm(at - p) < UNPLANNED_NEAR for p in failed)
+            rank = (tried, lever(pose, centre) > LEVER_MAX)
+            if rank == (False, False):
                 return
-            first_on = k if first_on is None else first_on
-        if first_on is not None:
-            s.select_grasp(BENCH, first_on, 0)
+            if best is None or rank < best[0]:
+                best = (rank, k)
+        if best is not None:
+            s.select_grasp(BENCH, best[1], 0)
         else:
             s.auto_grasp(BENCH)
+
+    def saw_unplanned(self, instance: str, position: np.ndarray) -> None:
+        """The user saw the grasp they chose at `position` (m, `base`) on `instance` fail to
+        plan: `choose` passes its cluster by from now on."""
+        self._unplanned.setdefault(instance, []).append(self.referee.to_world(position))
 
     def pick(self, rec: Attempt, aim: np.ndarray | None = None) -> bool:
         """Mark `rec.instance`, choose a grasp the way `rec.selection` says, and execute.
@@ -279,6 +298,8 @@ class ScriptedOperator:
             if closed is not None:
                 rec.grip = (executed[-1]["grasp"]["width"], closed)
         rec.detected = self.referee.object_at(chosen, before) == rec.instance
+        if rec.selection == "manual" and not executed and s.failure and s.failure.kind == "ik_plan":
+            self.saw_unplanned(rec.instance, chosen)
         lifted = any(e.get("state") == "holding" for e in self._events_since(k, "state"))
         rec.grasped = lifted and rec.detected  # what was lifted was the marked object
         if executed and not rec.detected:

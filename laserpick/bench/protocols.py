@@ -97,6 +97,10 @@ FLOOR_ACROSS = (0.0, 0.1, -0.1, 0.2, -0.2)
 #: stood before, and as on target within this distance (m) of the mark plus its offset.
 UPRIGHT_TILT = math.radians(15.0)
 PLACE_TOLERANCE = 0.03
+#: m the user leaves between the footprint of what they set down and anything else on the
+#: surface: the fingers' room about it, and a few cm for the object's middle going down only
+#: about over the mark (the robot centres what it saw of the object).
+PLACE_ROOM = 0.07
 #: Where the dot of a place mark lands on something in front of the spot (an object between
 #: the seat and it), the user moves the aim by these (m, the surface's x back and y across)
 #: until the dot lies within `picking.DOT_ON_SPOT` of where they aim, as a person who
@@ -437,50 +441,66 @@ def coin_flip_kitchen(rng: np.random.Generator) -> Scene:
 _OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 
 
-def free_spot(op: ScriptedOperator, surface: Surface) -> tuple[float, np.ndarray] | None:
+def free_spot(
+    op: ScriptedOperator, surface: Surface, room: float, held: str
+) -> tuple[float, np.ndarray] | None:
     """A spot on the top of `surface`, 25 cm behind its front edge (half its depth if that is
-    less) and 15 cm from every object: (local y, world xyz). A shelf's top, not its lower
-    boards: under a board the cameras see no dot and no surface. None when the surface has
-    no such spot."""
+    less), `room` m from every point of the objects there but `held`: (local y, world xyz).
+    A shelf's top, not its lower boards: under a board the cameras see no dot and no
+    surface. None when the surface has no such spot."""
     half_w = surface.size[1] / 2 - 0.15
     level = surface.levels[-1]
     depth = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
-    objects = _objects(op)
+    others = _standing(op, level, held)
     for _ in range(100):
         ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
         xy = surface.to_world(np.array([-surface.size[0] / 2 + depth, ly]))
-        if _free(objects, xy, level):
+        if _free(others, xy, room):
             return ly, np.array([xy[0], xy[1], level])
     return None
 
 
-def _objects(op: ScriptedOperator) -> list[np.ndarray]:
-    """Where every object stands now (m, `world`)."""
-    return [op.referee.world_position(n) for n in op.referee.instances()]
+def room_for(op: ScriptedOperator, instance: str) -> float:
+    """How far (m) the user keeps a spot from everything else to set `instance` down there:
+    the reach of its footprint as it stands now (its points' farthest, level, from their
+    middle), plus PLACE_ROOM. 15 cm from the other objects' middles, whatever was held, set
+    the plush toy lying on its side down onto the glass cup's rim, which no camera sees."""
+    pts = op.referee.object_points(instance, frame="world")[:, :2]
+    middle = (pts.min(axis=0) + pts.max(axis=0)) / 2
+    return float(np.linalg.norm(pts - middle, axis=1).max()) + PLACE_ROOM
 
 
-def _free(objects: list[np.ndarray], xy: np.ndarray, level: float) -> bool:
-    """Whether the spot `xy` (m, `world`) at height `level` is 15 cm from every one of
-    `objects` (m, `world`) at about that height."""
-    return all(np.linalg.norm(o[:2] - xy) > 0.15 for o in objects if abs(o[2] - level) < 0.1)
+def _standing(op: ScriptedOperator, level: float, but: str) -> np.ndarray:
+    """Where the objects other than `but` that stand at about height `level` (m) reach: their
+    points' level positions (n, 2; m, `world`)."""
+    ref = op.referee
+    near = [n for n in ref.instances() if n != but and abs(ref.world_position(n)[2] - level) < 0.1]
+    pts = [ref.object_points(n, frame="world")[:, :2] for n in near]
+    return np.vstack(pts) if pts else np.zeros((0, 2))
+
+
+def _free(others: np.ndarray, xy: np.ndarray, room: float) -> bool:
+    """Whether the spot `xy` (m, `world`) lies `room` m from every point of `others` (n, 2)."""
+    return len(others) == 0 or float(np.min(np.linalg.norm(others - xy, axis=1))) > room
 
 
 def _aims_in_sight(
-    op: ScriptedOperator, surface: Surface, spot: np.ndarray
+    op: ScriptedOperator, surface: Surface, spot: np.ndarray, room: float, held: str
 ) -> Iterator[np.ndarray]:
     """Where the user marks, in turn, to put something at `spot` (m, `world`, on `surface`'s
-    top; `base` out): each aim of AIM_SHIFTS that is free, on the surface and lit by the
+    top; `base` out): each aim of AIM_SHIFTS that is free (`room` m from the objects there
+    but `held`), on the surface and lit by the
     dot (the spot itself first, where the dot lands on it), then the last of them (the spot,
     where none is) for as long as asked. A person moves the mark on when the dot lands on
     something in front of the spot, and when the robot refuses to place there."""
     half = np.asarray(surface.size[:2]) / 2
     local = surface.to_local(spot[:2])
-    objects = _objects(op)
+    others = _standing(op, spot[2], held)
     last = None
     for dx, dy in AIM_SHIFTS:
         moved = local + (dx, dy)
         xy = surface.to_world(moved)
-        if np.any(np.abs(moved) > half - 0.05) or not _free(objects, xy, spot[2]):
+        if np.any(np.abs(moved) > half - 0.05) or not _free(others, xy, room):
             continue
         target = op.referee.to_base(np.array([xy[0], xy[1], spot[2]]))
         op.aim(target, watched=True)
@@ -552,6 +572,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         return rec.fail("precondition", NO_PARKING)
     session.set_mode(op.actor, mode="pick_and_place")
     quat_before = referee.world_quat(rec.instance)
+    room = room_for(op, rec.instance)
     if not op.pick(rec) or rec.failure is not None:
         return rec
     if session.state != TaskState.AWAITING_PLACE:
@@ -572,7 +593,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
     # takes the next, as a person with something in hand would.
     failure = Failure("precondition", "no surface to put it on")
     for dest in (dests[int(k)] for k in op.rng.permutation(len(dests))):
-        spot = free_spot(op, dest)
+        spot = free_spot(op, dest, room, rec.instance)
         if spot is None:
             failure = Failure("precondition", f"no free spot on {dest.name}")
             continue
@@ -585,7 +606,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         failure = Failure("precondition", f"the user could not park at {dest.name}")
     else:
         return rec.fail(failure.kind, failure.message)
-    aims = _aims_in_sight(op, dest, spot_world)
+    aims = _aims_in_sight(op, dest, spot_world, room, rec.instance)
     for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand still holds it
         placed = op.place(aim)
         rec.places += 1
