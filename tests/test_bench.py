@@ -42,8 +42,10 @@ from laserpick.bench.protocols import (
     _operated,
     _still_there,
     coin_flip_kitchen,
+    free_spot,
     jeeves_scene,
     placed_tilt,
+    room_for,
     round_about_z,
     scan_points,
 )
@@ -499,15 +501,45 @@ def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
         hidden = np.array([1.65, 0.12, 0.46])  # 25 cm behind the box, seen from the seat
         op.aim(op.referee.to_base(hidden))
         assert op.referee.dot_on("box"), "the box hides the spot"
-        target = next(_aims_in_sight(op, table, hidden))
+        room = 0.10  # for something small in hand
+        target = next(_aims_in_sight(op, table, hidden, room, None))
         assert np.linalg.norm(target - op.referee.to_base(hidden)) > 0.04
         op.aim(target)
         assert not op.referee.dot_on("box")
         assert np.linalg.norm(op.referee.to_base(op.robot.laser_hits()[0]) - target) < 0.03
         in_sight = np.array([1.65, -0.40, 0.46])
-        first, second, *_ = itertools.islice(_aims_in_sight(op, table, in_sight), 3)
+        aims = _aims_in_sight(op, table, in_sight, room, None)
+        first, second, *_ = itertools.islice(aims, 3)
         assert np.allclose(first, op.referee.to_base(in_sight))
         assert 0.04 < np.linalg.norm(second - first) < 0.06  # 5 cm across, still on the top
+
+
+def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) -> None:
+    """The robot cannot see a glass cup; the user can, and puts a plush toy lying on its
+    side (17 cm long) down only where all of it clears the cup, on the line of spots the
+    cup stands on (25 cm behind the front edge). A pill bottle fits nearer."""
+    scene = tmp_path / "cup.yaml"
+    scene.write_text(
+        "name: cup\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: t, kind: table, xy: [1.6, 0.0], size: [0.6, 1.2], height: 0.46}\n"
+        "  - {name: f, kind: floor, xy: [0.0, 2.0], size: [1.0, 1.0]}\n"
+        "objects:\n  - {name: cup, model: glass_cup, on: t, xy: [1.55, 0.0]}\n"
+        "  - {name: toy, model: stuffed_toy, on: f, xy: [0.0, 2.0], lying: true}\n"
+        "  - {name: pill, model: pill_bottle, on: f, xy: [0.3, 1.7]}\n"
+    )
+    loaded = load_scene(str(scene))
+    with _operated(loaded, 0, 1, Options()) as op:
+        cup = op.referee.object_points("cup", frame="world")[:, :2]
+        toy = op.referee.object_points("toy", frame="world")[:, :2]
+        reach = np.linalg.norm(toy - (toy.min(axis=0) + toy.max(axis=0)) / 2, axis=1).max()
+        assert reach > 0.08, "lying down, the toy reaches 8.7 cm from its middle"
+        room = room_for(op, "toy")
+        assert room > reach + 0.05 and room > room_for(op, "pill") + 0.04
+        for _ in range(20):
+            found = free_spot(op, loaded.surface("t"), room, "toy")
+            assert found is not None
+            gap = np.linalg.norm(cup - found[1][:2], axis=1).min()
+            assert gap > reach + 0.05, f"the toy would stand {gap - reach:.3f} m from the cup"
 
 
 def test_the_user_watches_the_dot_of_a_place_mark_on_a_top_just_below_the_pointer(

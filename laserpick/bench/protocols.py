@@ -442,7 +442,7 @@ _OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 
 
 def free_spot(
-    op: ScriptedOperator, surface: Surface, room: float, held: str
+    op: ScriptedOperator, surface: Surface, room: float, held: str | None
 ) -> tuple[float, np.ndarray] | None:
     """A spot on the top of `surface`, 25 cm behind its front edge (half its depth if that is
     less), `room` m from every point of the objects there but `held`: (local y, world xyz).
@@ -470,7 +470,7 @@ def room_for(op: ScriptedOperator, instance: str) -> float:
     return float(np.linalg.norm(pts - middle, axis=1).max()) + PLACE_ROOM
 
 
-def _standing(op: ScriptedOperator, level: float, but: str) -> np.ndarray:
+def _standing(op: ScriptedOperator, level: float, but: str | None) -> np.ndarray:
     """Where the objects other than `but` that stand at about height `level` (m) reach: their
     points' level positions (n, 2; m, `world`)."""
     ref = op.referee
@@ -485,7 +485,7 @@ def _free(others: np.ndarray, xy: np.ndarray, room: float) -> bool:
 
 
 def _aims_in_sight(
-    op: ScriptedOperator, surface: Surface, spot: np.ndarray, room: float, held: str
+    op: ScriptedOperator, surface: Surface, spot: np.ndarray, room: float, held: str | None
 ) -> Iterator[np.ndarray]:
     """Where the user marks, in turn, to put something at `spot` (m, `world`, on `surface`'s
     top; `base` out): each aim of AIM_SHIFTS that is free (`room` m from the objects there
