@@ -400,22 +400,28 @@ class Behaviours:
         approach: np.ndarray,
         checker: CollisionChecker,
         payload: np.ndarray | None = None,
+        *,
+        level: bool = True,
     ) -> Failure | None:
-        """After a grasp from the side, draw the hand straight back out along its `approach`
-        (unit, `base`), level, by `approach_distance` (or half that where the whole is not
-        clear of `checker`, with `payload` in the hand): after a lift, out of a shelf's gap
-        before the arm swings anywhere (a swing planned from inside the 69 cm shelf found
-        no way out, or met the board above); after a place, off the object it let go of.
-        A grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising.
+        """Draw the hand straight back along its `approach` (unit, `base`) by
+        `approach_distance` (or half that where the whole is not clear of `checker`, with
+        `payload` in the hand).
+
+        level: after a lift from the side, back level, out of a shelf's gap before the arm
+        swings anywhere (a swing planned from inside the 69 cm shelf found no way out, or
+        met the board above); a grasp from above (within WITHDRAW_STEEP of the vertical)
+        leaves by rising instead. Not level: after a place, back along the approach itself,
+        the fingers sliding off the object they let go of the way they came (drawn back
+        level from 43 deg above the side, they dragged a plush toy's head over).
 
         An arm that starts within the checker's margin of something (set down beside other
         objects, say) still leaves, if the whole way keeps the clearance it starts with:
         half the margin, or none short of touching."""
-        level = np.hypot(*approach[:2])
-        if level < np.sin(WITHDRAW_STEEP):
+        across = float(np.hypot(*approach[:2]))
+        if level and across < np.sin(WITHDRAW_STEEP):
             return None
         s = self.settings.motion
-        back = -np.append(approach[:2] / level, 0.0)
+        back = -np.append(approach[:2] / across, 0.0) if level else -approach
         q = self._q()
         margin = next(
             (
@@ -685,7 +691,7 @@ class Behaviours:
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
-        hand opens and leaves it (drawn back along its approach from the side, else
+        hand opens and leaves it (drawn back along its approach where that way is clear, else
         straight up), and the arm stows around the object where it now stands. Felt more
         than `place_above` early, it is something on the surface: the hand keeps the object
         and rises. Nothing felt by `place_below` under the rest: the hand keeps it.
@@ -775,14 +781,14 @@ class Behaviours:
         return Outcome(None, held.grasp, spot=spot)
 
     def _leave_placed(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
-        """Take the open hand off what it has just set down: drawn back along its approach,
-        level, if it holds from the side and that way is clear of `checker` (which leaves
-        the object out: the fingers start about it), else straight up to the TCP pose
-        T_above (4, 4, `base`), the way it came down. Risen straight up from the side, the
-        hand stayed about a tall box's top (a cereal box that had slid 3.6 cm down in the
-        pads stood 1 cm above the fingers), and no way to ready was found."""
+        """Take the open hand off what it has just set down: drawn back along its approach
+        if that way is clear of `checker` (which leaves the object out: the fingers start
+        about it), else straight up to the TCP pose T_above (4, 4, `base`), the way it came
+        down. Risen straight up from the side, the hand stayed about a tall box's top (a
+        cereal box that had slid 3.6 cm down in the pads stood 1 cm above the fingers), and
+        no way to ready was found."""
         start = tcp_pose(self._q())
-        failure = self._withdraw(start[:3, 2], checker)
+        failure = self._withdraw(start[:3, 2], checker, level=False)
         if failure is None and np.linalg.norm(tcp_pose(self._q())[:3, 3] - start[:3, 3]) < 0.01:
             self._rise_straight(T_above, "rising from the object")  # not drawn back
         return failure

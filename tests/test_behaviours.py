@@ -689,9 +689,9 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
-    """From the side, drawn back off the object, level: straight up, the fingers stayed
-    about a tall box's top. From above, or where the way back is not clear, straight up
-    to the pose above the place, the way it came down."""
+    """Drawn back off the object along the approach: from the side, straight up, the
+    fingers stayed about a tall box's top. From above, or where the way back is not clear,
+    straight up to the pose above the place, the way it came down."""
     b = Behaviours(robot)
     free = CollisionChecker(np.zeros((0, 3)))
     q_side, above = _hand_at(b, _side_pose(1.70, -0.30, 0.80))
@@ -706,6 +706,18 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     _, above = _hand_at(b, _top_down(1.6, -0.3, 0.8))
     assert b._leave_placed(above, free) is None
     np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
+    # From 45 deg above the side: back along the approach itself, up and back, not level
+    # (drawn back level, the fingers dragged a plush toy's head over).
+    oblique = np.eye(4)
+    approach = np.array([np.sqrt(0.5), 0.0, -np.sqrt(0.5)])
+    across = np.array([0.0, 1.0, 0.0])
+    oblique[:3, :3] = np.column_stack([np.cross(across, approach), across, approach])
+    oblique[:3, 3] = [1.6, -0.3, 0.8]
+    _, above = _hand_at(b, oblique)
+    assert b._leave_placed(above, free) is None
+    moved = tcp_pose(robot.joint_state().q)[:3, 3] - oblique[:3, 3]
+    assert np.linalg.norm(moved) > 0.045  # 10 cm, or 5 where the whole way is not clear
+    np.testing.assert_allclose(moved / np.linalg.norm(moved), -approach, atol=0.05)
 
 
 def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_clear(robot):
