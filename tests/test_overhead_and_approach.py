@@ -105,3 +105,32 @@ def test_closed_loop_on_a_unicycle_reaches_the_target():
             break
         pose += [cmd.v * c * dt, cmd.v * sn * dt, cmd.w * dt]
     assert cmd.done
+
+
+def test_the_overhead_strategy_segments_a_pill_beside_a_phone_with_the_grid(tmp_path):
+    """EL-E's grasp takes EL-E's segmentation (000 section 4.2.2): an 8 mm pill, 22 cm from
+    a phone, is its own occupancy-grid component. 004's clusters lose it to the 1.5 cm plane
+    removal, and the overhead grasp of their 10 cm ball about the mark closed on the table
+    beside it (in `surfaces`, on the phone). As `surfaces` sets out EL-E's second table, seen
+    from where the user parks."""
+    from laserpick.bench.picking import BENCH
+    from laserpick.bench.protocols import Options, _operated
+    from laserpick.robot.scenes import load_scene
+    from laserpick.server.session import TaskState
+
+    scene = tmp_path / "pill.yaml"
+    scene.write_text(
+        "name: pill\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n"
+        "  - {name: t, kind: table, xy: [1.75, -0.15], size: [0.6, 0.9], height: 0.698}\n"
+        "objects:\n"
+        "  - {name: phone, model: cordless_phone, on: t, xy: [1.57, -0.27], yaw_deg: 30}\n"
+        "  - {name: pill, model: pill, on: t, xy: [1.60, -0.05], yaw_deg: 45}\n"
+    )
+    with _operated(load_scene(str(scene)), 0, 1, Options(tremor_deg=0.0)) as op:
+        s = op.session
+        s.set_mode(BENCH, strategy="overhead")
+        assert op.mark(op.new_attempt("pill", "auto", "overhead"))
+        assert s.state == TaskState.GRASPS_READY
+        grasp = np.asarray(s.status()["current"]["position"])
+        assert op.referee.object_at(grasp) == "pill"
