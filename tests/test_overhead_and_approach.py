@@ -107,12 +107,12 @@ def test_closed_loop_on_a_unicycle_reaches_the_target():
     assert cmd.done
 
 
-def test_the_overhead_strategy_segments_a_pill_beside_a_phone_with_the_grid(tmp_path):
-    """EL-E's grasp takes EL-E's segmentation (000 section 4.2.2): an 8 mm pill, 22 cm from
-    a phone, is its own occupancy-grid component. 004's clusters lose it to the 1.5 cm plane
-    removal, and the overhead grasp of their 10 cm ball about the mark closed on the table
-    beside it (in `surfaces`, on the phone). As `surfaces` sets out EL-E's second table, seen
-    from where the user parks."""
+def test_the_overhead_grasp_of_a_pill_beside_a_phone_closes_on_the_pill(tmp_path):
+    """An 8 mm pill goes with 004's 1.5 cm plane removal, and the segmentation falls back on
+    its 10 cm ball about the mark, less the phone's cluster at its edge: whole, the ball held
+    part of the phone, and the overhead grasp closed between them (in `surfaces`, on the
+    phone, 9 of 12 pills). As `surfaces` sets out EL-E's second table, seen from where the
+    user parks."""
     from laserpick.bench.picking import BENCH
     from laserpick.bench.protocols import Options, _operated
     from laserpick.robot.scenes import load_scene

@@ -257,16 +257,26 @@ def test_euclidean_clusters_are_radius_graph_components():
     assert euclidean_clusters(np.zeros((0, 3)), 0.005).shape == (0,)
 
 
-def test_small_cluster_falls_back_to_the_ball():
-    pts, _ = _box_on_patch(np.random.default_rng(2))
-    # A few points standing 3 cm above the table's middle: a 30-point cluster.
-    tuft = np.column_stack([np.full(30, 1.35), np.linspace(0, 0.02, 30), np.full(30, 0.53)])
+def test_small_cluster_falls_back_to_the_ball_less_the_other_objects():
+    """A 30-point tuft 7 cm before a box: 004's 10 cm ball about the mark, less the box,
+    which is a cluster of its own (whole, the ball about a pill took in part of a phone)."""
+    pts, n_box = _box_on_patch(np.random.default_rng(2))
+    # A few points standing 3 cm above the table: a 30-point cluster.
+    tuft = np.column_stack([np.full(30, 1.40), np.linspace(0, 0.02, 30), np.full(30, 0.53)])
     cloud = _synthetic(np.concatenate([pts, tuft]))
-    mark = np.array([1.35, 0.01, 0.53], np.float32)
-    seg = segment_target(cloud, mark, SETTINGS.model_copy(update={"plane_min_inliers": 4000}))
+    mark = np.array([1.40, 0.01, 0.53], np.float32)
+    # The table's 17,000 points make a plane; the box's top does not.
+    seg = segment_target(cloud, mark, SETTINGS.model_copy(update={"plane_min_inliers": 20000}))
     assert isinstance(seg, Segmentation) and seg.method == "ball"
     d = np.linalg.norm(cloud.points[seg.indices] - mark, axis=1)
     assert d.max() <= SETTINGS.fallback_ball_radius + 1e-6
+    # The box's points in the ball, but for its bottom cm, which is one with the table's noise.
+    box = np.arange(len(pts) - n_box, len(pts))
+    in_ball = np.linalg.norm(cloud.points[box] - mark, axis=1) <= 0.1
+    near_box = box[in_ball & (cloud.points[box, 2] > 0.51)]
+    assert len(near_box) > 50, "part of the box lies in the ball"
+    assert not np.isin(near_box, seg.indices).any()
+    assert np.isin(np.arange(len(pts), len(cloud)), seg.indices).all(), "the tuft is in it"
 
 
 def test_a_floor_filling_the_view_is_found_around_the_mark():

@@ -49,7 +49,7 @@ from laserpick.pipeline.cloud import fuse, ray_hit
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
-from laserpick.pipeline.perceive import Perception, SegmentationMethod, perceive
+from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.recall import Recalled, ViewMemory
 from laserpick.pipeline.selection import GraspCursor
@@ -158,16 +158,12 @@ class _Foreseen:
 
     capture: _Capture
     point: np.ndarray
-    method: SegmentationMethod
     perception: Perception
     lit: np.ndarray | None
 
-    def of(self, capture: _Capture | None, point: np.ndarray, method: SegmentationMethod) -> bool:
-        """Whether this is the mark at `point` (m, `base`) worked out in `capture` with
-        `method`."""
-        return (
-            self.capture is capture and np.array_equal(self.point, point) and self.method == method
-        )
+    def of(self, capture: _Capture | None, point: np.ndarray) -> bool:
+        """Whether this is the mark at `point` (m, `base`) worked out in `capture`."""
+        return self.capture is capture and np.array_equal(self.point, point)
 
 
 def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
@@ -509,8 +505,7 @@ class Session:
                     self._require_motion(actor, "laser/confirm")
                 self._set(TaskState.MARKED, "Marked. Looking at the object.")
                 seen = self._foreseen
-                method = self._segmentation()
-                if seen is not None and point is not None and seen.of(self._capture, point, method):
+                if point is not None and seen is not None and seen.of(self._capture, point):
                     # Worked out since the aim, and the job will take this same result:
                     # the projector lights the target now, not after the job's first step.
                     self._projection = seen.lit
@@ -767,20 +762,16 @@ class Session:
         return self._foresight.submit(self._work_out, self._capture, point, seq)
 
     def _work_out(self, capture: _Capture | None, point: np.ndarray, seq: int) -> _Foreseen | None:
-        seen, method = self._foreseen, self._segmentation()
-        if seen is not None and seen.of(capture, point, method):
+        seen = self._foreseen
+        if seen is not None and seen.of(capture, point):
             return seen
         if seq != self._foresee_seq or capture is None or capture is not self._fresh_capture():
             return None
         perception = perceive(
-            capture.frames,
-            point=point,
-            method=method,
-            settings=self.settings.perception,
-            cloud=capture.cloud,
+            capture.frames, point=point, settings=self.settings.perception, cloud=capture.cloud
         )
         lit = highlight_points(self.projector, perception.target_points) if perception.ok else None
-        seen = _Foreseen(capture, np.array(point, float), method, perception, lit)
+        seen = _Foreseen(capture, np.array(point, float), perception, lit)
         self._foreseen = seen
         with self._lock:
             self._emit("foreseen")
@@ -795,14 +786,6 @@ class Session:
             return None
         return seen.capture.cloud, seen.lit
 
-    def _segmentation(self) -> SegmentationMethod:
-        """How a mark's target is segmented: EL-E's overhead grasp with EL-E's occupancy grid
-        (000 section 4.2.2), every other strategy with 004's clusters (section 6.1). 004's
-        fallback for a cluster under 500 points, the 10 cm ball about the mark, took in
-        what lay beside an 8 mm pill, and the overhead grasp closed on that: the phone, for
-        9 of the 12 `surfaces` pills."""
-        return "grid" if self.strategy == "overhead" else "cluster"
-
     def _perceive_job(self, point: np.ndarray | None = None) -> None:
         """Capture, find the mark in the IR images, segment. With `point` (a confirming click,
         m in `base`), the mark is that point, worked out in the capture it was aimed in while
@@ -814,9 +797,7 @@ class Session:
             t0 = time.perf_counter()
             frames = self.robot.capture()
             captured = time.perf_counter() - t0
-            perception = perceive(
-                frames, point=point, method=self._segmentation(), settings=self.settings.perception
-            )
+            perception = perceive(frames, point=point, settings=self.settings.perception)
             self._remember(frames, perception.cloud)
             lit = (
                 highlight_points(self.projector, perception.target_points)
