@@ -489,10 +489,10 @@ def _aims_in_sight(
 ) -> Iterator[np.ndarray]:
     """Where the user marks, in turn, to put something at `spot` (m, `world`, on `surface`'s
     top; `base` out): each aim of AIM_SHIFTS that is free (`room` m from the objects there
-    but `held`), on the surface and lit by the
-    dot (the spot itself first, where the dot lands on it), then the last of them (the spot,
-    where none is) for as long as asked. A person moves the mark on when the dot lands on
-    something in front of the spot, and when the robot refuses to place there."""
+    but `held`), on the surface and lit by the dot (the spot itself first, where the dot
+    lands on it), then the last of them (the spot, where none is) for as long as asked. A
+    person moves the mark on when the dot lands on something in front of the spot, and when
+    the robot refuses to place there."""
     half = np.asarray(surface.size[:2]) / 2
     local = surface.to_local(spot[:2])
     others = _standing(op, spot[2], held)
