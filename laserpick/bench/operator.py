@@ -68,8 +68,11 @@ class Referee:
 
     robot: SimRobot
 
+    def _T_world_base(self) -> np.ndarray:
+        return planar_pose(*self.robot.sim.snapshot().base_pose)
+
     def _T_base_world(self) -> np.ndarray:
-        return invert(planar_pose(*self.robot.sim.snapshot().base_pose))
+        return invert(self._T_world_base())
 
     def instances(self) -> list[str]:
         """The scene's object instances."""
@@ -114,11 +117,11 @@ class Referee:
 
     def to_world(self, base: np.ndarray) -> np.ndarray:
         """A `base` point (m) in `world` now."""
-        return (invert(self._T_base_world()) @ np.append(base, 1.0))[:3]
+        return (self._T_world_base() @ np.append(base, 1.0))[:3]
 
     def position(self, instance: str) -> np.ndarray:
         """The object's origin in `base` (m)."""
-        return (self._T_base_world() @ np.append(self.world_position(instance), 1.0))[:3]
+        return self.to_base(self.world_position(instance))
 
     def _posed(self) -> mujoco.MjData:
         """A copy of the simulation's state with its kinematics computed, to read geoms from."""
@@ -155,10 +158,11 @@ class Referee:
             return world
         return (self._T_base_world() @ np.c_[world, np.ones(len(world))].T).T[:, :3]
 
-    def all_object_points(self) -> dict[str, np.ndarray]:
-        """`object_points` of every object, now: take it before a pick moves them."""
+    def all_object_points(self, frame: Literal["base", "world"] = "base") -> dict[str, np.ndarray]:
+        """`object_points` of every object (m, in `frame`), now: take it before a pick moves
+        them."""
         posed = self._posed()
-        return {name: self.object_points(name, posed) for name in self.instances()}
+        return {name: self.object_points(name, posed, frame) for name in self.instances()}
 
     def object_at(
         self, position: np.ndarray, points: dict[str, np.ndarray] | None = None

@@ -474,8 +474,11 @@ def _standing(op: ScriptedOperator, level: float, but: str | None) -> np.ndarray
     """Where the objects other than `but` that stand at about height `level` (m) reach: their
     points' level positions (n, 2; m, `world`)."""
     ref = op.referee
-    near = [n for n in ref.instances() if n != but and abs(ref.world_position(n)[2] - level) < 0.1]
-    pts = [ref.object_points(n, frame="world")[:, :2] for n in near]
+    pts = [
+        p[:, :2]
+        for n, p in ref.all_object_points(frame="world").items()
+        if n != but and abs(ref.world_position(n)[2] - level) < 0.1
+    ]
     return np.vstack(pts) if pts else np.zeros((0, 2))
 
 

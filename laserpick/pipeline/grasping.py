@@ -39,7 +39,7 @@ from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled
 from laserpick.pipeline.selection import GraspClusters, group, score
-from laserpick.pipeline.surface import surface_height, voi_mask
+from laserpick.pipeline.surface import surface_height
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import MotionSettings, Settings, get_settings
 
@@ -137,7 +137,7 @@ def _above_surface(
     left above the surface were scattered over the ball, and the raised-point rule chose
     one, 7 cm from the pill. The whole target where no surface is seen."""
     s = settings.perception
-    z_top = surface_height(points[voi_mask(points, mark, s)], s)
+    z_top = surface_height(points, s, center=mark)
     if z_top is None:
         return target
     above = target[target[:, 2] > z_top + s.grid_surface_margin]
