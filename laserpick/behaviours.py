@@ -66,6 +66,15 @@ RISE_OUT = 0.05
 #: rad: a grasp whose approach leans farther than this from the vertical is from the side,
 #: and is drawn back out along it after the lift (`Behaviours._withdraw`).
 WITHDRAW_STEEP = np.radians(30.0)
+#: Turns (rad) about the vertical of the level way back from a side grasp, tried in order
+#: when straight back along the approach is not clear: a pill bottle lifted in the 69 cm
+#: shelf, reached into at 35 deg, brought the elbow into the scooter's sensor post drawn
+#: straight back, and left clear turned 15 deg; from inside the gap no tuck was found.
+WITHDRAW_TURNS = tuple(np.radians([0.0, 15.0, -15.0, 30.0, -30.0]))
+#: Times the tuck searches for a way before it raises the object in front instead: each
+#: search is random, and from a hand just drawn out of the 69 cm shelf's gap the second found
+#: the way the first had not (the session's retreat then tucked it in, the task failed).
+TUCK_SEARCHES = 2
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
 #: Turns (rad) of the last wrist joint tried, in order, for a pose the arm holds an object in
@@ -409,10 +418,11 @@ class Behaviours:
 
         level: after a lift from the side, back level, out of a shelf's gap before the arm
         swings anywhere (a swing planned from inside the 69 cm shelf found no way out, or
-        met the board above); a grasp from above (within WITHDRAW_STEEP of the vertical)
-        leaves by rising instead. Not level: after a place, back along the approach itself,
-        the fingers sliding off the object they let go of the way they came (drawn back
-        level from 43 deg above the side, they dragged a plush toy's head over).
+        met the board above): along the approach, else turned by each of WITHDRAW_TURNS; a
+        grasp from above (within WITHDRAW_STEEP of the vertical) leaves by rising instead.
+        Not level: after a place, back along the approach itself, the fingers sliding off
+        the object they let go of the way they came (drawn back level from 43 deg above the
+        side, they dragged a plush toy's head over).
 
         An arm that starts within the checker's margin of something (set down beside other
         objects, say) still leaves, if the whole way keeps the clearance it starts with:
@@ -421,7 +431,11 @@ class Behaviours:
         if level and across < np.sin(WITHDRAW_STEEP):
             return None
         s = self.settings.motion
-        back = -np.append(approach[:2] / across, 0.0) if level else -approach
+        backs = (
+            [rotz(turn) @ -np.append(approach[:2] / across, 0.0) for turn in WITHDRAW_TURNS]
+            if level
+            else [-approach]
+        )
         q = self._q()
         margin = next(
             (
@@ -434,7 +448,9 @@ class Behaviours:
         if margin is None:  # touching already: no level way out is known to be clear
             return None
         here = tcp_pose(q)
-        for distance in (s.approach_distance, s.approach_distance / 2):
+        for back, distance in itertools.product(
+            backs, (s.approach_distance, s.approach_distance / 2)
+        ):
             T = here.copy()
             T[:3, 3] += distance * back
             path = cartesian_line(q, T, s.cartesian_step)
@@ -592,8 +608,8 @@ class Behaviours:
         """Hold what the hand holds folded back beside the scooter (`dims.UR5_CARRY_Q`) while
         the user drives and marks where it goes: out of the cameras' view, the laser's way and
         the furniture's (raised in front, the object hangs 1.6 m ahead of the rear axle, into
-        a shelf the scooter parks at). Where no way there is found, raised in front (the high
-        ready pose)."""
+        a shelf the scooter parks at). Where TUCK_SEARCHES searches find no way there, raised
+        in front (the high ready pose)."""
         held = self.held
         if held is None:
             return Outcome(Failure("precondition", "The hand is not holding anything."))
@@ -601,15 +617,13 @@ class Behaviours:
         if failure is not None:
             return Outcome(failure)
         high = self._holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp)
-        out = self.go_to(
-            self._holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp),
-            held.surroundings,
-            "tucking it in",
-            via=(high,),
-            payload=held.points_tcp,
-        )
-        if out.ok or out.failure is None or out.failure.kind != "ik_plan":
-            return out  # it went there, or a motion was stopped: no second one
+        carry = self._holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp)
+        for _ in range(TUCK_SEARCHES):
+            out = self.go_to(
+                carry, held.surroundings, "tucking it in", via=(high,), payload=held.points_tcp
+            )
+            if out.ok or out.failure is None or out.failure.kind != "ik_plan":
+                return out  # it went there, or a motion was stopped: no second one
         return self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
 
     @staticmethod

@@ -523,6 +523,13 @@ class MotionSettings(BaseModel):
         description="Lift (m) after the grasp where the full `lift` is blocked, as under a"
         " shelf's board: enough to take the object off its support. Ours.",
     )
+    lift_least: float = Field(
+        0.03,
+        gt=0,
+        description="Lift (m) after the grasp where even `lift_low` is blocked: 1 cm over the"
+        " re-grip's, off the support, to be drawn back level out of the gap (a hand reaching"
+        " 30 deg down into the 69 cm shelf met the board above with its wrist at 4 cm). Ours.",
+    )
     guard_force: float = Field(
         25.0,
         gt=0,

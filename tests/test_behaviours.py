@@ -5,6 +5,7 @@ basket (judged by the simulator)."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -675,6 +676,29 @@ def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
     assert b._withdraw(_top_down(1.6, -0.3, 0.8)[:3, 2], free, payload) is None
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
+
+
+def test_a_side_grasp_blocked_straight_back_draws_back_level_a_little_turned(robot):
+    """A post beside the way straight back (the scooter's sensor post, where the elbow came
+    back out of the 69 cm shelf): the hand backs out level, turned from the approach by
+    at most 30 deg, rather than staying in the gap."""
+    b = Behaviours(robot)
+    side = _side_pose(1.70, -0.30, 0.80)
+    q_side, _ = _hand_at(b, side)
+    straight = [cartesian_line(q_side, _side_pose(x, -0.30, 0.80)) for x in (1.60, 1.65)]
+    post = None
+    for x, y in itertools.product(np.arange(1.58, 1.40, -0.02), np.arange(-0.33, -0.45, -0.01)):
+        near = CollisionChecker(np.array([[x, y, z] for z in np.arange(0.6, 1.0, 0.01)]))
+        if near.clearance_ok(q_side)[0] and not any(near.clearance_ok(p).all() for p in straight):
+            post = near
+            break
+    assert post is not None, "no post beside the way back blocks it"
+    assert b._withdraw(side[:3, 2], post) is None
+    moved = tcp_pose(robot.joint_state().q)[:3, 3] - side[:3, 3]
+    assert abs(moved[2]) < 0.005 and np.linalg.norm(moved) > 0.045, "backed out level"
+    turn = np.degrees(np.arccos(-moved[0] / np.linalg.norm(moved)))
+    assert 10 < turn < 35, f"turned {turn:.0f} deg from straight back"
+    assert post.clearance_ok(robot.joint_state().q)[0]
 
 
 def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -365,9 +365,9 @@ def test_from_the_stowed_arm_the_transit_goes_out_through_the_unstow_pose():
     assert np.abs(plan.transit.q - unstow).max(axis=1).min() > 0.05
 
 
-def test_under_a_board_the_lift_is_the_low_one_and_under_a_lower_one_none():
+def test_under_a_board_the_lift_is_the_low_one_then_the_least_then_none():
     """A board above the arm that the full lift would reach leaves the low lift; one that
-    even the low lift would reach leaves none."""
+    the low lift would reach, the least; one that even the least would reach, none."""
     s = get_settings().motion
     T = top_grasp(1.55, -0.25, 0.70)
     q = ik_tcp(T, dims.UR5_READY_Q)[0]
@@ -380,7 +380,8 @@ def test_under_a_board_the_lift_is_the_low_one_and_under_a_lower_one_none():
     rise = tcp_pose(full)[:, 2, 3] - T[2, 3]
     tops = (centres[:, arm, 2] + SPHERES.radius[arm]).max(axis=1)
     top_low = float(tops[rise <= s.lift_low + 1e-9].max())
-    assert tops.max() > top_low + 0.02  # the full lift rises higher
+    top_least = float(tops[rise <= s.lift_least + 1e-9].max())
+    assert tops.max() > top_low + 0.02 and top_low > top_least + 0.006  # each rises higher
 
     def lifted(board_z: float) -> float | None:
         board = table(z=board_z, x=(T[0, 3] - 0.1, T[0, 3] + 0.1), y=(T[1, 3] - 0.1, T[1, 3] + 0.1))
@@ -389,6 +390,7 @@ def test_under_a_board_the_lift_is_the_low_one_and_under_a_lower_one_none():
 
     assert lifted(float(tops.max()) + s.clearance + 0.01) == pytest.approx(s.lift, abs=1e-6)
     assert lifted(top_low + s.clearance + 0.005) == pytest.approx(s.lift_low, abs=1e-6)
+    assert lifted(top_least + s.clearance + 0.002) == pytest.approx(s.lift_least, abs=1e-6)
     assert lifted(float(tops[0]) + s.clearance + 0.005) is None
 
 
