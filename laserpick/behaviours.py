@@ -424,9 +424,11 @@ class Behaviours:
         the object they let go of the way they came (drawn back level from 43 deg above the
         side, they dragged a plush toy's head over).
 
-        An arm that starts within the checker's margin of something (set down beside other
+        A hand that starts within the checker's margin of something (set down beside other
         objects, say) still leaves, if the whole way keeps the clearance it starts with:
-        half the margin, or none short of touching."""
+        half the margin, or none short of touching. The arm keeps its own: drawn back
+        within the hand's clearance from a bottle set down on the 73 cm table, the elbow
+        came within the margin of the sensor post, and no way home could start there."""
         across = float(np.hypot(*approach[:2]))
         if level and across < np.sin(WITHDRAW_STEEP):
             return None
@@ -437,16 +439,15 @@ class Behaviours:
             else [-approach]
         )
         q = self._q()
+        margins = (checker.margin, checker.margin / 2, 0.0)
         margin = next(
-            (
-                m
-                for m in (checker.margin, checker.margin / 2, 0.0)
-                if checker.clearance_ok(q, payload=payload, margin=m)[0]
-            ),
-            None,
+            (m for m in margins if checker.clearance_ok(q, payload=payload, margin=m)[0]), None
         )
         if margin is None:  # touching already: no level way out is known to be clear
             return None
+        arm_margin = next(
+            m for m in margins if m <= margin or checker.clearance_ok(q, hand=False, margin=m)[0]
+        )
         here = tcp_pose(q)
         for back, distance in itertools.product(
             backs, (s.approach_distance, s.approach_distance / 2)
@@ -454,7 +455,11 @@ class Behaviours:
             T = here.copy()
             T[:3, 3] += distance * back
             path = cartesian_line(q, T, s.cartesian_step)
-            if path is None or not checker.clearance_ok(path, payload=payload, margin=margin).all():
+            if (
+                path is None
+                or not checker.clearance_ok(path, payload=payload, margin=margin).all()
+                or not checker.clearance_ok(path, hand=False, margin=arm_margin).all()
+            ):
                 continue
             return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
         return None

@@ -769,6 +769,41 @@ def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
 
 
+def test_a_hand_that_starts_within_the_margin_leaves_the_arm_its_own(robot):
+    """The fingers start 5-10 mm from something (the surface an object was set down on);
+    the arm, clear by the full margin where it starts, keeps it on the way back: it may not
+    end within the margin of a post behind, where no planner could start."""
+    b = Behaviours(robot)
+    side = _side_pose(1.70, -0.30, 0.80)
+    q_side, _ = _hand_at(b, side)
+    ahead = next(
+        near
+        for x in np.arange(1.70, 1.90, 0.001)
+        if (near := CollisionChecker(np.array([[x, -0.30, 0.80]]))).clearance_ok(
+            q_side, margin=0.005
+        )[0]
+        and not near.clearance_ok(q_side)[0]
+    )
+    back = cartesian_line(q_side, _side_pose(1.60, -0.30, 0.80))
+    margin = ahead.margin
+    post = None
+    for x, y, z in itertools.product(
+        np.arange(1.20, 1.60, 0.01), np.arange(-0.45, -0.15, 0.01), (0.70, 0.90, 1.10)
+    ):
+        near = CollisionChecker(np.array([[x, y, z]]))
+        if (
+            near.clearance_ok(q_side, hand=False)[0]
+            and near.clearance_ok(back, margin=margin / 2).all()
+            and not near.clearance_ok(back[-1:], hand=False)[0]
+        ):
+            post = near
+            break
+    assert post is not None, "no point comes within the margin of the arm drawn back"
+    both = CollisionChecker(np.vstack([ahead.points, post.points]))
+    assert b._withdraw(side[:3, 2], both) is None
+    assert post.clearance_ok(robot.joint_state().q, hand=False)[0]
+
+
 def test_the_hand_comes_down_turned_where_the_arm_would_come_down_on_something(robot):
     """Something where the wrist would come down, unturned, behind a hand that holds from the
     side: the place turns the hand (PLACE_YAWS) so that the arm comes down clear of it.
