@@ -781,17 +781,20 @@ class Behaviours:
         # and as the cameras now see it: a cereal box that had slid and turned in the pads
         # stood 3 cm from where it was held, and the wrist met it on the way home (156 N).
         standing = held.points_tcp @ T_release[:3, :3].T + T_release[:3, 3]
-        around = CollisionChecker(
-            np.vstack([checker.points, standing, self._seen_now()]),
-            margin=s.clearance,
-            filtered=True,
-        )
+        seen = np.vstack([checker.points, self._seen_now()])
+        around = CollisionChecker(np.vstack([seen, standing]), margin=s.clearance, filtered=True)
         # A guard stop short of the surface (the wrist met the floor: 2 of 39 pick-place
         # tasks) leaves the straight rise short of clearing the object.
         failure = self._rise_clear(around, hand_on_the_way=False)
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot)
         back = self.stow(around)
+        if back.failure is not None and back.failure.kind == "ik_plan":
+            # The object as held stands for more than it is (a plush toy's mirrored back):
+            # the hand drawn 5 cm back out of one still stood 2 mm inside it, and no way
+            # home could start. Around what the cameras see alone, the session's own stow
+            # then found one.
+            back = self.stow(CollisionChecker(seen, margin=s.clearance, filtered=True))
         if back.failure is not None:
             msg = back.failure.message
             failure = Failure(back.failure.kind, f"Set down; then {msg[:1].lower()}{msg[1:]}")
