@@ -445,6 +445,7 @@ class Behaviours:
         )
         if margin is None:  # touching already: no level way out is known to be clear
             return None
+        # The arm's own: the largest margin it starts clear of, never less than the hand's.
         arm_margin = next(
             m for m in margins if m <= margin or checker.clearance_ok(q, hand=False, margin=m)[0]
         )

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from pydantic import BaseModel, Field, SecretStr
+from pydantic import BaseModel, Field, SecretStr, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 
@@ -578,6 +578,17 @@ class MotionSettings(BaseModel):
         " descent: the surface was met. EL-E felt 2 N at its fingers; an arm's"
         " joint-current estimate is coarser. Ours.",
     )
+
+    @model_validator(mode="after")
+    def _lifts_in_order(self) -> MotionSettings:
+        """Each lift tried after a blocked one is lower, and the least still rises above the
+        re-grip's (a lower one would put the object back down)."""
+        if not self.regrip_lift < self.lift_least <= self.lift_low <= self.lift:
+            raise ValueError(
+                "need regrip_lift < lift_least <= lift_low <= lift (m), got"
+                f" {self.regrip_lift}, {self.lift_least}, {self.lift_low}, {self.lift}"
+            )
+        return self
 
 
 class ServerSettings(BaseModel):

@@ -8,6 +8,7 @@ import math
 import mujoco
 import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from laserpick.description import dims
 from laserpick.description.collision import KEEPOUT_BOXES, body_frames
@@ -33,7 +34,7 @@ from laserpick.pipeline.plan import (
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.model import ModelInfo, build_sim_model
-from laserpick.settings import get_settings
+from laserpick.settings import MotionSettings, get_settings
 
 EMPTY = np.zeros((0, 3))
 
@@ -469,3 +470,13 @@ def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch
     assert calls == [(0.0, 0.5)] and not searches.spent
     assert searches.path(ready, pre, checker, rng, s) is None
     assert searches.spent and searches.failed == 2
+
+
+def test_lifts_out_of_order_are_refused_saying_which():
+    """A least lift under the re-grip's would set the object back down; a low lift above
+    the full one would never be tried. Either is refused with the four values."""
+    with pytest.raises(ValidationError, match="regrip_lift < lift_least <= lift_low <= lift"):
+        MotionSettings(lift_least=0.01)
+    with pytest.raises(ValidationError, match=r"0\.02, 0\.03, 0\.12, 0\.1"):
+        MotionSettings(lift_low=0.12)
+    assert MotionSettings(lift_least=0.05).lift_least == 0.05

@@ -251,9 +251,7 @@ def straight_lift(
     """The straight lift from q_from to `lift` above the grasp pose T_grasp, or to `lift_low`
     where the full lift is blocked (a shelf's board above), or to `lift_least` where that is
     too: joint waypoints, or None if none is clear of the surroundings for the arm."""
-    for height in sorted(
-        {s.lift, min(s.lift_low, s.lift), min(s.lift_least, s.lift)}, reverse=True
-    ):
+    for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
         T_lift = T_grasp.copy()
         T_lift[2, 3] += height
         lift = cartesian_line(q_from, T_lift, s.cartesian_step)
