@@ -744,19 +744,23 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     np.testing.assert_allclose(moved / np.linalg.norm(moved), -approach, atol=0.05)
 
 
+def _point_ahead(q_side: np.ndarray) -> CollisionChecker:
+    """A point 5-10 mm ahead of the fingers of the hand at `_side_pose(1.70, -0.30, 0.80)`
+    (joint angles q_side): inside the 1 cm margin, short of touching."""
+    for x in np.arange(1.70, 1.90, 0.001):
+        near = CollisionChecker(np.array([[x, -0.30, 0.80]]))
+        if near.clearance_ok(q_side, margin=0.005)[0] and not near.clearance_ok(q_side)[0]:
+            return near
+    pytest.fail("no point ahead of the hand lies 5-10 mm from it")
+
+
 def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_clear(robot):
     """Something 5-10 mm ahead of the fingers (inside the 1 cm margin) does not keep the hand
     from drawing back away from it; something the way back comes closer to does."""
     b = Behaviours(robot)
     side = _side_pose(1.70, -0.30, 0.80)
     q_side, _ = _hand_at(b, side)
-    ahead = None
-    for x in np.arange(1.70, 1.90, 0.001):
-        near = CollisionChecker(np.array([[x, -0.30, 0.80]]))
-        if near.clearance_ok(q_side, margin=0.005)[0] and not near.clearance_ok(q_side)[0]:
-            ahead = near
-            break
-    assert ahead is not None, "no point ahead of the hand lies 5-10 mm from it"
+    ahead = _point_ahead(q_side)
     assert b._withdraw(side[:3, 2], ahead) is None
     np.testing.assert_allclose(
         tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
@@ -776,14 +780,7 @@ def test_a_hand_that_starts_within_the_margin_leaves_the_arm_its_own(robot):
     b = Behaviours(robot)
     side = _side_pose(1.70, -0.30, 0.80)
     q_side, _ = _hand_at(b, side)
-    ahead = next(
-        near
-        for x in np.arange(1.70, 1.90, 0.001)
-        if (near := CollisionChecker(np.array([[x, -0.30, 0.80]]))).clearance_ok(
-            q_side, margin=0.005
-        )[0]
-        and not near.clearance_ok(q_side)[0]
-    )
+    ahead = _point_ahead(q_side)
     back = cartesian_line(q_side, _side_pose(1.60, -0.30, 0.80))
     margin = ahead.margin
     post = None
