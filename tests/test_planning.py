@@ -218,6 +218,47 @@ def test_filter_swaps_the_fingers_when_that_turns_the_wrist_less():
     assert np.allclose(out.pose[:3, 0], -T[:3, 0]) and yaw
 
 
+def test_filter_drops_a_grasp_under_a_board_the_arm_could_not_lift_it_from():
+    """A side grasp under a board: clear at the grasp and at the pre-grasp behind it, but the
+    wrist would come within the margin of the board as the hand lifts the least lift. Such a
+    grasp is one the hand could close on and never raise, so the filter drops it, saying so;
+    a board higher up leaves it."""
+    s = get_settings().motion
+    T = np.eye(4)
+    T[:3, :3] = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # approach +x
+    T[:3, 3] = [1.7, -0.25, 0.70]
+    q = reachable([Grasp(T, 0.05)], CollisionChecker(EMPTY), dims.UR5_READY_Q)[0].ik
+    assert q is not None
+    # The board is a patch over the hand and wrist, 35 cm by 30 cm, short of the elbow.
+    lo, hi = np.array([1.5, -0.4]), np.array([1.85, -0.1])
+
+    def top(pose: np.ndarray, hand: bool) -> float:
+        """The highest point under the patch of the arm's spheres, with the hand's or not."""
+        centres = sphere_centres(body_frames(ik_tcp(pose, q)[0]))[0]
+        r = SPHERES.radius
+        under = np.all((centres[:, :2] > lo - r[:, None]) & (centres[:, :2] < hi + r[:, None]), 1)
+        under &= hand | ~SPHERES.hand
+        return float((centres[under, 2] + r[under]).max())
+
+    pre = T.copy()
+    pre[:3, 3] -= s.approach_distance * T[:3, 2]
+    up = T.copy()
+    up[2, 3] += s.lift_least
+    below = max(top(T, False), top(pre, True))
+    assert top(up, False) > below + 0.02
+
+    def kept(board_z: float, lift: float) -> Grasp:
+        board = table(z=board_z, x=(lo[0], hi[0]), y=(lo[1], hi[1]))
+        checker = CollisionChecker(board, margin=s.clearance, voxel=0.0)
+        return reachable([Grasp(T, 0.05)], checker, dims.UR5_READY_Q, lift=lift)[0]
+
+    low = below + s.clearance + 0.01
+    assert kept(low, 0.0).ik is not None  # the board is clear of the grasp and the pre-grasp
+    refused = kept(low, s.lift_least)
+    assert refused.ik is None and "as it lifts" in refused.ik_failure
+    assert kept(top(up, False) + s.clearance + 0.005, s.lift_least).ik is not None
+
+
 def test_cartesian_line_is_straight():
     q0 = dims.UR5_READY_Q
     T0 = tcp_pose(q0)

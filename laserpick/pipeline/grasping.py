@@ -220,7 +220,7 @@ def find_grasps(
     timings: dict[str, float] = {}
     cloud, seg = perception.cloud, perception.segmentation
     target = cloud.points[seg.indices].astype(np.float64)
-    approach = s.motion.approach_distance
+    approach, lift = s.motion.approach_distance, s.motion.lift_least
 
     t0 = time.perf_counter()
     found = candidates(perception, strategy, s, rng)
@@ -241,7 +241,7 @@ def find_grasps(
         q_self=q_capture,
         frames=(*perception.frames, *recalled.frames),
     )
-    checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach)
+    checked = [] if isinstance(found, Failure) else reachable(found, world, q_ref, approach, lift)
     timings["filter"] = time.perf_counter() - t0
 
     def add(
@@ -256,7 +256,7 @@ def find_grasps(
             return False
         t0 = time.perf_counter()
         step = 1 if most is None else max(1, -(-len(more) // most))
-        checked.extend(reachable(more[::step], world, q_ref, approach))
+        checked.extend(reachable(more[::step], world, q_ref, approach, lift))
         timings["filter"] += time.perf_counter() - t0
         return True
 

@@ -2,9 +2,10 @@
 touching the cloud, the scooter or its rider.
 
 For each grasp, every analytic IK solution of the grasp pose is tried, nearest the reference
-configuration first; the pre-grasp pose `approach_distance` back along the approach axis must
-then be solvable on the same branch, and both configurations must be collision-free. The
-hand itself is not checked at the grasp (grasp detection did that exactly); it is at the
+configuration first; the pre-grasp pose `approach_distance` back along the approach axis and
+the pose `lift` straight above the grasp must then be solvable on the same branch, and all
+three configurations must be collision-free. The hand itself is not checked at the grasp
+(grasp detection did that exactly) nor lifted (it holds the object there); it is at the
 pre-grasp. Frames: `base`, metres, radians.
 """
 
@@ -39,10 +40,24 @@ def pregrasp_pose(pose: np.ndarray, distance: float) -> np.ndarray:
     return out
 
 
+def lifted_pose(pose: np.ndarray, height: float) -> np.ndarray:
+    """The TCP pose `height` (m) straight above `pose` (`base` z is up)."""
+    out = pose.copy()
+    out[2, 3] += height
+    return out
+
+
 COLLIDES = "every arm posture for this grasp collides with something"
+CANNOT_LIFT = "the arm would meet something above it as it lifts this grasp"
 
 
 Option = tuple[np.ndarray, np.ndarray] | None  #: (joint solution, grasp pose), None: collides
+
+
+def _on_branch(pose: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+    """The IK solution (6,) rad of TCP `pose` nearest q, if it lies on q's branch."""
+    Q = ik_tcp(pose, q)
+    return Q[0] if len(Q) and np.max(np.abs(Q[0] - q)) < BRANCH_JUMP else None
 
 
 def _clear_options(
@@ -69,12 +84,15 @@ def reachable(
     checker: CollisionChecker,
     q_ref: np.ndarray,
     approach_distance: float = 0.10,
+    lift: float = 0.0,
 ) -> list[Grasp]:
     """The grasps with `ik` set to a collision-free solution, or with `ik_failure` saying why.
 
     q_ref (6,) rad: where the arm starts the grasp motion (the ready pose). Each grasp is also
     tried with its fingers swapped, which turns the wrist by a half turn; the nearer wins, and
-    its pose replaces the grasp's.
+    its pose replaces the grasp's. lift (m): the least lift the pick makes
+    (`MotionSettings.lift_least`); the arm must be clear there too, or the grasp is one the
+    hand could close on but never raise (under a shelf's board). 0 skips the check.
     """
     # Per grasp, its IK options (solution, pose), nearest q_ref first.
     options: list[list[Option]] = []
@@ -98,27 +116,37 @@ def reachable(
     for rank in range(max((len(o) for o in options), default=0)):
         if rank == 1:
             options = _clear_options(options, chosen, checker, failure)
-        todo, q_grasp, q_pre = [], [], []
+        todo, q_grasp, q_pre, q_up = [], [], [], []
         for i, o in enumerate(options):
             if i in chosen or rank >= len(o) or o[rank] is None:
                 continue
             q, pose = o[rank]
-            pre = ik_tcp(pregrasp_pose(pose, approach_distance), q)
-            if len(pre) and np.max(np.abs(pre[0] - q)) < BRANCH_JUMP:
+            pre = _on_branch(pregrasp_pose(pose, approach_distance), q)
+            up = _on_branch(lifted_pose(pose, lift), q) if lift > 0 else q
+            if pre is not None and up is not None:
                 todo.append(i)
                 q_grasp.append(q)
-                q_pre.append(pre[0])
-            elif failure[i] == "the arm cannot reach this grasp":
+                q_pre.append(pre)
+                q_up.append(up)
+            elif pre is None and failure[i] == "the arm cannot reach this grasp":
                 failure[i] = "the arm cannot reach the pre-grasp pose behind this grasp"
+            elif pre is not None:
+                failure[i] = CANNOT_LIFT
         if not todo:
             continue
         ok = checker.clearance_ok(np.array(q_pre), hand=True)
         if rank == 0:
             ok &= checker.clearance_ok(np.array(q_grasp), hand=False)
+        if lift > 0:
+            lifted = checker.clearance_ok(np.array(q_up), hand=False)
+            for i, good, up_ok in zip(todo, ok, lifted, strict=True):
+                if good and not up_ok:
+                    failure[i] = CANNOT_LIFT
+            ok &= lifted
         for i, good in zip(todo, ok, strict=True):
             if good:
                 chosen[i] = options[i][rank]
-            else:
+            elif failure[i] != CANNOT_LIFT:
                 failure[i] = COLLIDES
     out = []
     for i, g in enumerate(grasps):
