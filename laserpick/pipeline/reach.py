@@ -60,6 +60,19 @@ def _on_branch(pose: np.ndarray, q: np.ndarray) -> np.ndarray | None:
     return Q[0] if len(Q) and np.max(np.abs(Q[0] - q)) < BRANCH_JUMP else None
 
 
+def _liftable(
+    options: Sequence[tuple[np.ndarray, np.ndarray]], lift: float, checker: CollisionChecker
+) -> np.ndarray:
+    """(B,) whether the arm at each (joint solution, grasp pose) can rise `lift` (m) straight
+    up: the lifted pose solves on the same IK branch, and the arm is clear there. The hand is
+    not checked: it holds the object, whose own points it meets."""
+    up = [_on_branch(lifted_pose(pose, lift), q) for q, pose in options]
+    out = np.array([u is not None for u in up])
+    if out.any():
+        out[out] = checker.clearance_ok(np.array([u for u in up if u is not None]), hand=False)
+    return out
+
+
 def _clear_options(
     options: list[list[Option]],
     chosen: dict[int, Option],
@@ -116,38 +129,34 @@ def reachable(
     for rank in range(max((len(o) for o in options), default=0)):
         if rank == 1:
             options = _clear_options(options, chosen, checker, failure)
-        todo, q_grasp, q_pre, q_up = [], [], [], []
+        todo, q_grasp, q_pre = [], [], []
         for i, o in enumerate(options):
             if i in chosen or rank >= len(o) or o[rank] is None:
                 continue
             q, pose = o[rank]
             pre = _on_branch(pregrasp_pose(pose, approach_distance), q)
-            up = _on_branch(lifted_pose(pose, lift), q) if lift > 0 else q
-            if pre is not None and up is not None:
+            if pre is not None:
                 todo.append(i)
                 q_grasp.append(q)
                 q_pre.append(pre)
-                q_up.append(up)
-            elif pre is None and failure[i] == "the arm cannot reach this grasp":
+            elif failure[i] == "the arm cannot reach this grasp":
                 failure[i] = "the arm cannot reach the pre-grasp pose behind this grasp"
-            elif pre is not None:
-                failure[i] = CANNOT_LIFT
         if not todo:
             continue
         ok = checker.clearance_ok(np.array(q_pre), hand=True)
         if rank == 0:
             ok &= checker.clearance_ok(np.array(q_grasp), hand=False)
-        if lift > 0:
-            lifted = checker.clearance_ok(np.array(q_up), hand=False)
-            for i, good, up_ok in zip(todo, ok, lifted, strict=True):
-                if good and not up_ok:
-                    failure[i] = CANNOT_LIFT
-            ok &= lifted
+        for i in np.array(todo)[~ok]:
+            failure[i] = COLLIDES
+        if lift > 0 and ok.any():
+            at = np.flatnonzero(ok)
+            up_ok = _liftable([options[todo[k]][rank] for k in at], lift, checker)
+            for k in at[~up_ok]:
+                failure[todo[k]] = CANNOT_LIFT
+            ok[at] = up_ok
         for i, good in zip(todo, ok, strict=True):
             if good:
                 chosen[i] = options[i][rank]
-            elif failure[i] != CANNOT_LIFT:
-                failure[i] = COLLIDES
     out = []
     for i, g in enumerate(grasps):
         if i in chosen:
