@@ -588,11 +588,8 @@ class Behaviours:
     def _rise_above(self, top: float, checker: CollisionChecker) -> Failure | None:
         """Lift the open hand straight up until its lowest point is above `top` (m, `base`
         z), or as near as the arm reaches straight up (close beside its base, above the
-        basket, it reaches little higher), in one move that keeps the arm and the hand
-        clear of `checker` (what was let go is not in it); none where no rise of a
-        centimetre or more is. The hand is checked too: risen with the arm alone checked,
-        a vitamin bottle's hand ended where no planner could start, even in an empty
-        cloud (the keep-out boxes around the scooter)."""
+        basket, it reaches little higher), in one move that keeps the arm clear of
+        `checker`; none where no rise of a centimetre or more is."""
         s = self.settings.motion
         q = self._q()
         need = min(top - hand_bottom(q), RISE_MAX)
@@ -600,7 +597,7 @@ class Behaviours:
             T = tcp_pose(q)
             T[2, 3] += height
             path = cartesian_line(q, T, s.cartesian_step)
-            if path is not None and checker.clearance_ok(path).all():
+            if path is not None and checker.clearance_ok(path, hand=False).all():
                 return self._run(timed(path, s, tcp_speed=s.approach_speed), "lifting clear")
         return None
 
