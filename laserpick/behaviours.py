@@ -26,12 +26,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.collision import (
-    CollisionChecker,
-    carried_shape,
-    hand_bottom,
-    obstacle_mask,
-)
+from laserpick.pipeline.collision import CollisionChecker, carried_shape, obstacle_mask
 from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
@@ -585,22 +580,6 @@ class Behaviours:
             risen += RISE_STEP
         return None
 
-    def _rise_above(self, top: float, checker: CollisionChecker) -> Failure | None:
-        """Lift the open hand straight up until its lowest point is above `top` (m, `base`
-        z), or as near as the arm reaches straight up (close beside its base, above the
-        basket, it reaches little higher), in one move that keeps the arm clear of
-        `checker`; none where no rise of a centimetre or more is."""
-        s = self.settings.motion
-        q = self._q()
-        need = min(top - hand_bottom(q), RISE_MAX)
-        for height in np.arange(need, 0.0099, -0.01):
-            T = tcp_pose(q)
-            T[2, 3] += height
-            path = cartesian_line(q, T, s.cartesian_step)
-            if path is not None and checker.clearance_ok(path, hand=False).all():
-                return self._run(timed(path, s, tcp_speed=s.approach_speed), "lifting clear")
-        return None
-
     def _rise_step(
         self, checker: CollisionChecker, payload: np.ndarray | None, hand: bool
     ) -> np.ndarray | None:
@@ -702,18 +681,15 @@ class Behaviours:
         self.progress("Released into the basket.")
         # The open hand rises off the object before it turns away: a tall bottle stands up
         # out of the basket, and a straight way to ready swept the fingers through it (152 N,
-        # a protective stop). The object can only have fallen from where the hand let go, so
-        # the hand first rises above its top as let go: a cereal box let go tipped against
-        # a finger, still between the fingers' tips, and the way home pushed it (153 N).
+        # a protective stop). The object can only have fallen from where the hand let go.
         T = tcp_pose(self._q())
         let_go = held.points_tcp @ T[:3, :3].T + T[:3, 3]
-        clearance = self.settings.motion.clearance
         around = CollisionChecker(
-            np.vstack([held.surroundings.points, let_go]), margin=clearance, filtered=True
+            np.vstack([held.surroundings.points, let_go]),
+            margin=self.settings.motion.clearance,
+            filtered=True,
         )
-        failure = self._rise_above(float(let_go[:, 2].max()) + clearance, held.surroundings)
-        if failure is None:
-            failure = self._rise_clear(around, hand_on_the_way=False)
+        failure = self._rise_clear(around, hand_on_the_way=False)
         if failure is not None:
             return Outcome(failure)
         # Around the object as it was let go, else as it fell, lower (no way around it). To

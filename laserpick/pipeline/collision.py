@@ -135,12 +135,6 @@ SEEN_TOLERANCE = 0.006
 _SPHERE_PROBES = np.vstack([np.zeros(3), np.eye(3), -np.eye(3)])
 
 
-def hand_bottom(q: np.ndarray) -> float:
-    """The lowest point (m, `base` z) of the hand's spheres at configuration q (6,) rad."""
-    centres = sphere_centres(body_frames(q))[0, SPHERES.hand]
-    return float((centres[:, 2] - SPHERES.radius[SPHERES.hand]).min())
-
-
 def _unstow_box() -> tuple[np.ndarray, np.ndarray]:
     """The box (lo, hi; `base`, m) around the hand's spheres on the straight joint move from
     the stowed pose to the unstow pose, grown by OWN_SPACE_PADDING: the scooter's own side,
