@@ -23,7 +23,7 @@ from laserpick.description import dims
 from laserpick.description.collision import GRIPPER_CAPSULES
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.reach import pregrasp_pose
+from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure
@@ -252,9 +252,7 @@ def straight_lift(
     where the full lift is blocked (a shelf's board above), or to `lift_least` where that is
     too: joint waypoints, or None if none is clear of the surroundings for the arm."""
     for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
-        T_lift = T_grasp.copy()
-        T_lift[2, 3] += height
-        lift = cartesian_line(q_from, T_lift, s.cartesian_step)
+        lift = cartesian_line(q_from, lifted_pose(T_grasp, height), s.cartesian_step)
         if lift is not None and surroundings.clearance_ok(lift, hand=False).all():
             return lift
     return None
@@ -328,9 +326,7 @@ def plan_pick(
     if approach is None or not world.clearance_ok(approach, hand=False).all():
         return Failure("ik_plan", "The straight approach to this grasp is blocked.")
     approach[-1] = q_grasp
-    T_up = T_grasp.copy()
-    T_up[2, 3] += s.regrip_lift
-    up = cartesian_line(q_grasp, T_up, s.cartesian_step)
+    up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
