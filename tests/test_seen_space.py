@@ -16,7 +16,10 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
-from laserpick.pipeline.plan import joint_path
+from laserpick.pipeline.grasping import UNSEEN_WAYS, GraspSet, plan_first
+from laserpick.pipeline.plan import Searches, joint_path
+from laserpick.pipeline.selection import group
+from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.settings import get_settings
@@ -91,3 +94,44 @@ def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
     assert path is not None
     Q = np.vstack([np.linspace(a, b, 20) for a, b in itertools.pairwise(path)])
     assert checker.clearance_ok(Q, seen=True).all()
+
+
+def _pre_grasp_beside_the_table() -> np.ndarray:
+    """The arm with the TCP 10 cm above a grasp from above beside the table's right edge,
+    right of every camera's view (rad)."""
+    return _hand_at(1.40, -0.75, 0.90)
+
+
+def test_a_leg_kept_from_unseen_space_says_a_way_led_through_it(world):
+    """The only ways from ready to beside the table pass space no camera saw: held to seen
+    space the search finds none, and the pick can say that a way through unseen space was
+    there. A leg that ends inside something has no way at all, seen or not."""
+    s = get_settings().motion.model_copy(update={"rrt_max_samples": 300})
+    rng = np.random.default_rng(0)
+    beside = _pre_grasp_beside_the_table()
+    searches = Searches(max_failed=6)
+    assert searches.path(READY, beside, world, rng, s) is None
+    assert searches.unseen_only(s)
+    table_top = world.points[np.argmax(world.points[:, 2])]
+    inside = _hand_at(*table_top)  # the hand in the table's top
+    walled = Searches(max_failed=6)
+    assert walled.path(READY, inside, world, rng, s) is None
+    assert not walled.unseen_only(s)
+    # Without frames nothing is unseen: nothing to say.
+    blind = CollisionChecker(world.points, filtered=True)
+    assert Searches(6).path(READY, beside, blind, rng, s) is not None
+
+
+def test_a_pick_whose_ways_all_pass_unseen_space_says_so(world):
+    """Planned from ready, a grasp beside the table fails for want of a way through seen
+    space, and the failure says that ways through unseen space were left untaken."""
+    s = get_settings().motion.model_copy(update={"rrt_max_samples": 300})
+    pose = tcp_pose(READY)
+    pose[:3, 3] = 1.40, -0.75, 0.80
+    q = ik_tcp(pose, READY)[0]
+    grasp = Grasp(pose=pose, width=0.05, ik=q)
+    found = GraspSet(group([grasp]), (), world, world, pose[:3, 3][None], "gpd")
+    plan, chosen, tried = plan_first(found, READY, np.random.default_rng(0), settings=s)
+    assert isinstance(plan, Failure) and chosen is None and tried == 1
+    assert plan.message.startswith("No collision-free path to this grasp was found")
+    assert plan.message.endswith(UNSEEN_WAYS)

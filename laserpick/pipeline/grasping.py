@@ -53,6 +53,12 @@ VERTICAL_TOP_POINTS = 30  #: points needed to place a vertical grasp by its band
 SPECKLE_NEIGHBOURS = 3
 STRATEGIES: tuple[Strategy, ...] = ("gpd", "overhead", "vertical")
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
+#: Said after a pick's planning failure when some way to its grasps passed only through space
+#: no camera saw: the arm keeps to seen space, so the user knows why it did not go.
+UNSEEN_WAYS = (
+    "; the only ways found pass where the cameras could not see, and the arm keeps to where"
+    " they saw"
+)
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
 TARGET_VOXEL = 0.01  #: m: the target's whole shape, as recalled views are checked against it
 
@@ -312,7 +318,8 @@ def plan_first(
     From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose;
     from the stowed pose, through the unstow pose first.
     The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
-    it there already. Returns the plan (or the last failure), its grasp and how many grasps
+    it there already. Returns the plan (or the last failure, which says so when ways
+    through space the cameras did not see were left untaken), its grasp and how many grasps
     were tried.
     """
     s = settings or get_settings().motion
@@ -342,5 +349,8 @@ def plan_first(
             return plan, grasp, tried
         if searches.spent:
             msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            return Failure("ik_plan", msg), None, tried
+            plan = Failure("ik_plan", msg)
+            break
+    if isinstance(plan, Failure) and searches.unseen_only(s):
+        plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
     return plan, None, tried
