@@ -711,8 +711,8 @@ class Behaviours:
         cloud: a fresh capture's fused cloud (the held object and the arm in it are ignored);
         blind: what the views from the way in saw where no camera sees now (m, `base`;
         `Recalled.blind_points`), planned around as the cloud is; mark: the place mark (m,
-        `base`). The mark must be on a flat surface (moved back from
-        its front edge if it is too close). The object goes down with the grasp's orientation
+        `base`). The mark must be on a flat surface (moved back from its front edge if it is
+        too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
         hand opens and leaves it (drawn back along its approach where that way is clear, else
