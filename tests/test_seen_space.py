@@ -96,19 +96,13 @@ def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
     assert checker.clearance_ok(Q, seen=True).all()
 
 
-def _pre_grasp_beside_the_table() -> np.ndarray:
-    """The arm with the TCP 10 cm above a grasp from above beside the table's right edge,
-    right of every camera's view (rad)."""
-    return _hand_at(1.40, -0.75, 0.90)
-
-
 def test_a_leg_kept_from_unseen_space_says_a_way_led_through_it(world):
     """The only ways from ready to beside the table pass space no camera saw: held to seen
     space the search finds none, and the pick can say that a way through unseen space was
     there. A leg that ends inside something has no way at all, seen or not."""
     s = get_settings().motion.model_copy(update={"rrt_max_samples": 300})
     rng = np.random.default_rng(0)
-    beside = _pre_grasp_beside_the_table()
+    beside = _hand_at(1.40, -0.75, 0.90)  # right of the table, of every camera's view
     searches = Searches(max_failed=6)
     assert searches.path(READY, beside, world, rng, s) is None
     assert searches.unseen_only(s)
@@ -117,7 +111,8 @@ def test_a_leg_kept_from_unseen_space_says_a_way_led_through_it(world):
     walled = Searches(max_failed=6)
     assert walled.path(READY, inside, world, rng, s) is None
     assert not walled.unseen_only(s)
-    # Without frames nothing is unseen: nothing to say.
+    # Without the frames nothing counts as unseen, and the same leg has a way: the cameras'
+    # view, not what they saw, blocked it.
     blind = CollisionChecker(world.points, filtered=True)
     assert Searches(6).path(READY, beside, blind, rng, s) is not None
 
