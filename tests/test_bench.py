@@ -229,12 +229,15 @@ def _running(pid: int) -> bool:
 
 def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:
     """Two selection trials (auto and manual on the same pair each): in this process, in two
-    spawned worker processes, and on a local Ray instance. The verdicts must agree."""
+    spawned worker processes, and on a local Ray instance. The verdicts must agree. The
+    second trial alone (`--seed 4 --trials 1`) replays it: a trial's number is only a label
+    (docs/bench.md, "Replaying one trial")."""
     import ray
 
     options = Options(selection="auto", strategy="gpd")
     inline = run("selection", trials=2, seed=3, options=options, workers=1)
     pooled = run("selection", trials=2, seed=3, options=options, workers=2)
+    alone = run("selection", trials=1, seed=4, options=options, workers=1)
     try:
         ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
         on_ray = run("selection", trials=2, seed=3, options=options, ray_address="auto")
@@ -245,6 +248,8 @@ def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:
     assert set(inline["modes"]) == {"auto", "manual"}
     assert outcomes(pooled) == outcomes(inline)
     assert outcomes(on_ray) == outcomes(inline)
+    second = [o[1:] for o in outcomes(inline) if o[0] == 1]
+    assert second and [o[1:] for o in outcomes(alone)] == second
     assert on_ray["options"]["ray"] == "auto"
     for r in inline["records"]:  # each attempt was timed, stage by stage
         if r["failure"] not in ("detect_laser", "precondition", "detect_grasp"):

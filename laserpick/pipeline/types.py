@@ -157,7 +157,8 @@ class Grasp:
 
     pose: (4, 4) TCP pose in `base`. Its columns are the hand axis (x), the closing axis (y,
     between the fingers) and the approach axis (z, from the palm toward the object), as in
-    GPD; the TCP is midway between the fingertips.
+    GPD; the TCP lies midway between the pads' centres, pad_depth / 2 behind the fingertips
+    (`description.dims.GRIPPER_TCP_OFFSET`).
     width: the object's extent between the fingers (m).
     scores: the selection factors, once scored.
     cluster: index of the position cluster for manual selection (-1 before clustering).
