@@ -77,6 +77,9 @@ WITHDRAW_TURNS = tuple(np.radians([0.0, 15.0, -15.0, 30.0, -30.0]))
 TUCK_SEARCHES = 2
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
+#: Height (m) above the surface an object stood on up to which points are the surface's own:
+#: its seen points scatter by a few millimetres (`carried_shape` fills down to this height).
+SUPPORT_SCATTER = 0.01
 #: Turns (rad) of the last wrist joint tried, in order, for a pose the arm holds an object in
 #: on the way (tucked in, raised in front): an object held by one end reaches back along the
 #: hand, and at one turn it comes within the margin of the upper arm where at another it
@@ -381,7 +384,7 @@ class Behaviours:
         support = lowest if grasps.support is None else min(grasps.support, lowest)
         pts = carried_shape(grasps.target, support)
         pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
-        around = self._without_leftovers(grasps.surroundings, grasps.target, support)
+        around = self._without_leftovers(grasps.surroundings, pts, support)
         self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, around)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
@@ -891,17 +894,21 @@ class Behaviours:
 
     @staticmethod
     def _without_leftovers(
-        surroundings: CollisionChecker, target: np.ndarray, support: float
+        surroundings: CollisionChecker, carried: np.ndarray, support: float
     ) -> CollisionChecker:
-        """`surroundings` less the points above the support surface (at `support`, m) within
-        CARRIED_PADDING of the target's seen points (`base`): parts of the object the
-        segmentation left out (a spray bottle's trigger head), which leave with it. Kept,
-        they stood where the lifted object now hangs, and no carry could start."""
+        """`surroundings` less the points within CARRIED_PADDING of the object's carried
+        shape (`carried`, m, `base`: `carried_shape`, what the cameras saw of it, its guessed
+        back and the column down to the surface it stood on, at `support`, m) and more than
+        SUPPORT_SCATTER above that surface: the object's own, which leave with it. Parts of
+        it the segmentation left out (a spray bottle's trigger head); parts of it that a view
+        from the way in saw where no camera sees now (a pill bottle's lower back, 2.7 cm
+        above the 69 cm board). Kept, they stood where the lifted object then hung, and no
+        carry or tuck could start."""
         pts = surroundings.points
-        if len(pts) == 0 or len(target) == 0:
+        if len(pts) == 0 or len(carried) == 0:
             return surroundings
-        d, _ = cKDTree(target).query(pts, distance_upper_bound=CARRIED_PADDING)
-        return surroundings.without(np.isfinite(d) & (pts[:, 2] > support + CARRIED_PADDING))
+        d, _ = cKDTree(carried).query(pts, distance_upper_bound=CARRIED_PADDING)
+        return surroundings.without(np.isfinite(d) & (pts[:, 2] > support + SUPPORT_SCATTER))
 
     @staticmethod
     def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:
