@@ -706,15 +706,11 @@ class Behaviours:
                     return back
         return back
 
-    def place(
-        self, cloud: FusedCloud, mark: np.ndarray, blind: np.ndarray | None = None
-    ) -> Outcome:
+    def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
         """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).
 
         cloud: a fresh capture's fused cloud (the held object and the arm in it are ignored);
-        blind: what the views from the way in saw where no camera sees now (m, `base`;
-        `Recalled.blind_points`), planned around as the cloud is; mark: the place mark (m,
-        `base`). The mark must be on a flat surface (moved back from
+        mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
@@ -732,8 +728,7 @@ class Behaviours:
         if isinstance(spot, Failure):
             return Outcome(Failure("precondition", f"I can't place there: {spot.message}."))
         q_now = self._q()
-        points = cloud.points if blind is None else np.vstack([cloud.points, blind])
-        obstacles = points[self._not_carried(points, q_now, held)]
+        obstacles = cloud.points[self._not_carried(cloud.points, q_now, held)]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
         found = self._place_poses(held, spot, q_now, checker)
         if isinstance(found, Failure):

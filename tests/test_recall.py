@@ -14,7 +14,6 @@ import pytest
 from driving import drive_back_and_in
 from scipy.spatial import cKDTree
 
-from laserpick.bench.picking import ScriptedOperator, open_session
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import CollisionChecker, self_filter, within_reach
 from laserpick.pipeline.free_space import hidden, seen_free
@@ -29,7 +28,7 @@ from laserpick.pipeline.recall import (
 from laserpick.pipeline.types import DepthFrame
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.server.session import Actor, Session, TaskState
+from laserpick.server.session import Actor, Session
 from laserpick.transforms import invert, planar_pose
 
 WALL_X = 2.0  #: m, in the odometry's frame: a wall facing the scooter's start, in part
@@ -232,50 +231,3 @@ def test_what_a_view_saw_of_the_target_hidden_now_is_the_target_not_an_obstacle(
     assert not part[n + m :].any()
     deeper = corner + [0.015, 0.0, 0.0]  # its unseen depth too
     assert on_target(deeper, seen, 1.0)[deeper[:, 2] > 1.005].all()
-
-
-def test_views_are_kept_on_the_way_to_a_place_and_the_place_plans_around_them():
-    """Holding an object tucked in beside the scooter, out of the cameras' view, the user
-    drives back and in to set it down: the views of the way are kept (with none of the arm
-    or the object in them), and the place, with the stow after it, plans around what they
-    saw where no camera sees now (the counter's corner beside the parked scooter, met at
-    203 N by the stow after a place that planned around the current capture alone)."""
-    scene = load_scene("isolation", seed=1)
-    session = open_session(scene, seed=1)
-    try:
-        op = ScriptedOperator(session, np.random.default_rng(1), trial=0, seed=1)
-        session.set_mode(op.actor, mode="pick_and_place")
-        rec = op.new_attempt(scene.placements[0].instance, "auto", "gpd")
-        assert op.pick(rec) and rec.failure is None, rec.message
-        assert session.state == TaskState.AWAITING_PLACE
-        q = session.robot.joint_state().q
-        assert not len(session.views)
-        drive_back_and_in(session, op.actor)
-        assert len(session.views) == session.settings.perception.recall_views
-        recalled = session._recalled()
-        held = session.behaviours.held
-        assert held is not None
-        assert session.behaviours._not_carried(recalled.points, q, held).all()
-        assert self_filter(recalled.points, q).all()
-        given: list[tuple[np.ndarray, np.ndarray]] = []
-        place = session.behaviours.place
-
-        def recording(cloud, mark, blind=None):
-            given.append((cloud.points, blind))
-            return place(cloud, mark, blind=blind)
-
-        session.behaviours.place = recording  # type: ignore[method-assign]
-        placed = op.place(np.array([1.45, 0.15, 0.46]))
-        assert placed.failure is None, placed.failure
-        ((now, blind),) = given
-
-        # The table's top right of the arm, beside the scooter's front, where the cameras
-        # see it now only in part: the views of the way in fill it in.
-        def corner(p: np.ndarray) -> np.ndarray:
-            return (p[:, 0] < 1.5) & (p[:, 1] < -0.5) & (np.abs(p[:, 2] - 0.46) < 0.02)
-
-        new = blind[corner(blind)]
-        gap, _ = cKDTree(now).query(new, distance_upper_bound=0.01)
-        assert np.isinf(gap).sum() > 50  # of the table's top there, seen then and not now
-    finally:
-        session.close()

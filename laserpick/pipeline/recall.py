@@ -10,8 +10,7 @@ odometry's pose at each, and hands them back re-expressed in the current `base` 
 
 - their frames, so that the planner's seen-space test counts what they saw through as seen;
 - their points where no camera sees now (`Recalled.blind_points`), so that what they saw
-  there (a shelf's board beside the arm, a table's leg, a counter's corner beside the
-  scooter where a place's stow folds the arm) is an obstacle.
+  there (a shelf's board beside the arm, a table's leg) is an obstacle.
 
 Where a camera sees now, the current capture alone says what is there: a view only fills in
 the blind spots, and only for a while (a view older than `max_age` s of robot time is

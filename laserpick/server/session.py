@@ -651,13 +651,10 @@ class Session:
         in view on the way in. In real time the capture runs on its own thread, so the drive
         command does not wait on it; headless, it runs at once, so a run replays exactly."""
         robot = self.robot
-        # Only with the arm stowed and the hand empty, as when a grasp is planned, or holding
-        # an object tucked in beside the scooter, as on the way to a place: out of the
-        # cameras' view, so a view never shows the arm elsewhere, nor what rides in the hand.
-        q, holding = robot.joint_state().q, robot.gripper_state().holding
-        stowed = at_pose(q, dims.UR5_HOME_Q) and not holding
-        tucked = holding and at_pose(q[:5], dims.UR5_CARRY_Q[:5])  # any turn of the wrist
-        if not (stowed or tucked) or not self.views.due(robot.base_pose()):
+        # Only with the arm stowed and the hand empty, as they are when a grasp is planned:
+        # a view never shows the arm elsewhere, nor an object riding along in the hand.
+        stowed = at_pose(robot.joint_state().q, dims.UR5_HOME_Q)
+        if not stowed or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
             return
         if not robot.sim.realtime:
             self._take_view(robot)
@@ -916,8 +913,7 @@ class Session:
         self.task.place_mark = mark.point
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
-        blind = self._recalled().blind_points(frames)
-        out = self.behaviours.place(cloud, mark.point, blind=blind)
+        out = self.behaviours.place(cloud, mark.point)
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)
