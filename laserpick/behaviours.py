@@ -900,10 +900,10 @@ class Behaviours:
         shape (`carried`, m, `base`: `carried_shape`, what the cameras saw of it, its guessed
         back and the column down to the surface it stood on, at `support`, m) and more than
         SUPPORT_SCATTER above that surface: the object's own, which leave with it. Parts of
-        it the segmentation left out (a spray bottle's trigger head); parts of it that a view
-        from the way in saw where no camera sees now (a pill bottle's lower back, 2.7 cm
-        above the 69 cm board). Kept, they stood where the lifted object then hung, and no
-        carry or tuck could start."""
+        it the segmentation left out (a spray bottle's trigger head, a pill bottle's lower
+        back 2.7 cm above the 69 cm board), or that the views from the way in saw where no
+        camera sees now. Kept, they stood where the lifted object then hung, and no carry
+        or tuck could start."""
         pts = surroundings.points
         if len(pts) == 0 or len(carried) == 0:
             return surroundings

@@ -507,11 +507,12 @@ def test_parts_of_the_object_the_segmentation_missed_leave_with_it():
 
 
 def test_what_a_view_saw_of_the_object_low_behind_it_leaves_with_it():
-    """A view from the way in saw a pill bottle's back low down, where no camera sees now: a
-    point 2.7 cm above the 69 cm board. It is the bottle's own, inside its carried shape
-    (the guessed back, filled down to the board), and leaves with it; kept, it stood where
-    the lifted bottle hung, and no tuck could start (seed-1 pick-place, with the views kept
-    on the way to a place). The board's points stay, and so does a neighbour 6 cm behind."""
+    """A point of a pill bottle's back low down, 2.7 cm above the 69 cm board, outside the
+    segmented target (the cameras see its front and cap). It is the bottle's own, inside its
+    carried shape (the guessed back, filled down to the board), and leaves with it; kept, it
+    stood where the lifted bottle hung, and no tuck could start (seed-1 pick-place, with
+    the views kept on the way to a place). The board's points stay, and so does a point
+    6 cm behind the bottle's back."""
     board, r, axis = 0.69, 0.02, np.array([1.51, -0.295])
     turns = np.radians(np.arange(90, 271, 15))  # the half facing the cameras (-x)
     heights = np.arange(board + 0.005, board + 0.08, 0.01)
