@@ -506,7 +506,7 @@ def test_parts_of_the_object_the_segmentation_missed_leave_with_it():
     }
 
 
-def test_what_a_view_saw_of_the_object_low_behind_it_leaves_with_it():
+def test_the_objects_own_points_low_behind_it_leave_with_it():
     """A point of a pill bottle's back low down, 2.7 cm above the 69 cm board, outside the
     segmented target (the cameras see its front and cap). It is the bottle's own, inside its
     carried shape (the guessed back, filled down to the board), and leaves with it; kept, it
