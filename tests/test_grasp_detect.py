@@ -267,6 +267,56 @@ def test_tilted_plate_is_not_antipodal():
     assert detect(pts, n) == []
 
 
+def test_a_pad_on_guessed_points_only_must_face_the_seen_ones():
+    # Frames 0-3, pads 0 (left) and 1 (right); depths along the approach (m).
+    f = np.array([0, 0, 1, 1, 2, 2, 3, 3])
+    side = np.array([0, 1, 0, 1, 0, 1, 0, 1])
+    depth = np.array([0.004, -0.004, 0.004, 0.002, 0.004, -0.004, 0.0, 0.0], np.float32)
+    guessed = np.array([0, 1, 0, 1, 0, 0, 1, 1], bool)
+    contacts = [(f, side, depth, guessed)]
+    wider = [(np.array([0]), np.array([0]), np.array([0.010], np.float32), np.array([False]))]
+    ok = gd.guesses_face_seen(contacts + wider, 4)
+    # 0: the guessed pad (-4 mm) lies in front of the seen one (4-10 mm): refused.
+    # 1: the guessed pad at 2 mm, the seen one at 4 mm: no overlap, refused; with the seen
+    #    pad reaching 2 mm it is kept. 2: both seen: the rule does not apply.
+    # 3: both pads guessed: nothing seen is held, refused.
+    np.testing.assert_array_equal(ok, [False, False, True, False])
+    reach = [(np.array([1]), np.array([0]), np.array([0.002], np.float32), np.array([False]))]
+    assert gd.guesses_face_seen(contacts + reach, 4)[1]
+
+
+def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
+    # A seen plate at y = -2 cm, z 3-7 cm, and a guessed one at y = +2 cm, z 7-11 cm: from
+    # straight above, the pads would straddle the seam, one on each, at different depths.
+    # From the side, or leaning along the plates, both pads meet their plates at one depth.
+    X, Y, Z = np.eye(3)
+    seen = plate(np.array([-0.02, -0.02, 0.03]), 0.04 * X, 0.04 * Z, -Y)
+    back = plate(np.array([-0.02, 0.02, 0.07]), 0.04 * X, 0.04 * Z, Y)
+    pts, n = np.vstack([seen[0], back[0]]), noisy(np.vstack([seen[1], back[1]]))
+    guessed = np.r_[np.zeros(len(seen[0]), bool), np.ones(len(back[0]), bool)]
+    scene = np.vstack([table(), pts]).astype(np.float32)
+
+    def run(flags: np.ndarray | None) -> list[Grasp]:
+        rng = np.random.default_rng(0)
+        return detect_grasps(pts.astype(np.float32), n, scene, S, rng, guessed=flags)
+
+    def faces(g: Grasp) -> bool:
+        """Whether the pads' seen and guessed points overlap in depth (the plates are flat:
+        every point between the pads is a contact)."""
+        h, c, a = hand_coords(g, pts).T
+        pad = (np.abs(h) < S.pad_width / 2) & (a <= 0) & (a >= -S.pad_depth)
+        pad &= np.abs(c) < S.width_max / 2
+        on_seen, on_guess = a[pad & ~guessed], a[pad & guessed]
+        return max(on_seen.min(), on_guess.min()) <= min(on_seen.max(), on_guess.max())
+
+    free, ruled = run(None), run(guessed)
+    assert any(g.approach[2] < -0.9 and not faces(g) for g in free)  # from above
+    assert ruled and all(faces(g) for g in ruled)
+    assert {g.pose.tobytes() for g in ruled} <= {g.pose.tobytes() for g in free}
+    unflagged = run(np.zeros(len(pts), bool))  # all seen: nothing changes
+    assert [g.pose.tobytes() for g in unflagged] == [g.pose.tobytes() for g in free]
+
+
 # --- clutter -------------------------------------------------------------------------------
 
 
@@ -366,7 +416,7 @@ def test_antipodal_possible_never_rules_out_a_passing_frame():
     pts, n = cylinder()
     normals = noisy(n)
     samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
+    sid, _, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
     possible = gd.antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
     rng = np.random.default_rng(3)
     passed = np.zeros(len(possible), bool)
@@ -430,7 +480,7 @@ def test_detector_equals_the_direct_computation():
     has, k = gd.middle_placement(np.isfinite(tips))
     offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
     tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
+    tsid, _, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
     width, ok = gd.closing_region(tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s)
     good = np.flatnonzero(ok & has)
     poses = gd.grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)

@@ -660,14 +660,15 @@ def pad_pairs(
     normal: np.ndarray,
     axis: np.ndarray,
     s: GraspSettings,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, ...]:
     """Target points where some candidate's pads could be, for each sample: (sample index,
-    u, v, nu, nv), the points' coordinates (m) and their normals' components along the same
-    axes (see slab_pairs). The pads' hand-axis extent, out to the farthest pad corner."""
+    point index, u, v, nu, nv), the points' coordinates (m) and their normals' components
+    along the same axes (see slab_pairs). The pads' hand-axis extent, out to the farthest pad
+    corner."""
     reach = math.hypot(s.width_max, s.finger_length)
     region = [(s.pad_width / 2, reach, np.inf)]
-    sid, _, _, u, v, nu, nv = slab_pairs(target, samples, normal, axis, region, normals)
-    return sid, u, v, nu, nv
+    sid, pid, _, u, v, nu, nv = slab_pairs(target, samples, normal, axis, region, normals)
+    return sid, pid, u, v, nu, nv
 
 
 def antipodal_possible(
@@ -715,6 +716,11 @@ def antipodal_possible(
     return ((left >= s.gpd_min_contacts) & (right >= s.gpd_min_contacts)).reshape(n_samples, n_o)
 
 
+Contacts = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""Antipodal contacts: each one's frame, pad (0 left, 1 right), depth along the approach (m)
+and whether its point is guessed."""
+
+
 def closing_region(
     u: np.ndarray,
     v: np.ndarray,
@@ -725,6 +731,7 @@ def closing_region(
     offset: np.ndarray,
     tip: np.ndarray,
     s: GraspSettings,
+    guessed: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Width (m) and the antipodal verdict of each candidate frame.
 
@@ -732,11 +739,14 @@ def closing_region(
     pads' hand-axis extent; nu, nv: their normals' u and v components; frame: each pair's
     sample index times O (the orientation is added here). offset, tip: per frame (S * O), the
     chosen hand centre on the closing axis and fingertip depth (m); NaN for no candidate.
+    guessed: per pair, whether the point is guessed (`mirrored_back`) rather than seen.
 
     The pads touch the points between their inner faces within pad_depth of the tips. Their
     closing extent is the width. A pad's contacts are the points within gpd_contact_band of
     the extreme on its side; enough of them (gpd_min_contacts) must have normals within the
-    friction cone about the closing axis, pointing at that pad (GPD's antipodal rule).
+    friction cone about the closing axis, pointing at that pad (GPD's antipodal rule). A pad
+    that touches only guessed points must touch them where the other pad touches seen ones
+    (`guesses_face_seen`).
     """
     n_frames = len(offset)
     cmax = np.full(n_frames, -np.inf, np.float32)
@@ -759,14 +769,21 @@ def closing_region(
         np.maximum.at(cmax, f, cc)
         np.minimum.at(cmin, f, cc)
         count += np.bincount(f, minlength=n_frames)
-        parts.append((f, cc, ndot))
+        parts.append((i, f, cc, ndot, a[i]))
     cos_fric = math.cos(math.radians(s.gpd_friction_deg))
     left = np.zeros(n_frames, np.int64)
     right = np.zeros(n_frames, np.int64)
     band = s.gpd_contact_band
-    for f, cc, ndot in parts:
-        left += np.bincount(f[(cc >= cmax[f] - band) & (ndot >= cos_fric)], minlength=n_frames)
-        right += np.bincount(f[(cc <= cmin[f] + band) & (ndot <= -cos_fric)], minlength=n_frames)
+    contacts: list[Contacts] = []
+    for i, f, cc, ndot, depth in parts:
+        on_left = (cc >= cmax[f] - band) & (ndot >= cos_fric)
+        on_right = (cc <= cmin[f] + band) & (ndot <= -cos_fric)
+        left += np.bincount(f[on_left], minlength=n_frames)
+        right += np.bincount(f[on_right], minlength=n_frames)
+        if guessed is not None:
+            side = np.where(on_left, 0, 1)[on_left | on_right]
+            at = np.flatnonzero(on_left | on_right)
+            contacts.append((f.take(at), side, depth.take(at), guessed.take(i.take(at))))
     width = cmax - cmin
     ok = (
         (count >= s.gpd_min_points)
@@ -775,7 +792,34 @@ def closing_region(
         & (width > 0)
         & (width <= s.width_max)
     )
+    if guessed is not None:
+        ok &= guesses_face_seen(contacts, n_frames)
     return width, ok
+
+
+def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
+    """(n_frames,) bool: False where a pad's antipodal contacts are all guessed points and
+    their depths along the approach do not overlap those of the other pad's seen contacts.
+
+    The back `mirrored_back` guesses is right for a symmetric object seen square on. Seen at
+    a slant, or past an end, it lies beside the seen face rather than opposite it: a box
+    held by its end edge had one pad on its seen face, 4-11 mm behind the tips, and the other
+    only on guessed points, 4-10 mm in front of them (pick-place, seed 102, task 9). The
+    pads closed on 1.25 cm of a 6.75 cm grasp, and the box turned out of them. A pad on seen
+    points, and a guessed one at the same depth, are at least a real surface faced by its
+    likely back.
+    """
+    lo = np.full((2, 2, n_frames), np.inf, np.float32)  # [pad, guessed, frame]
+    hi = np.full((2, 2, n_frames), -np.inf, np.float32)
+    for f, side, depth, g in contacts:
+        np.minimum.at(lo, (side, g.astype(np.int64), f), depth)
+        np.maximum.at(hi, (side, g.astype(np.int64), f), depth)
+    ok = np.ones(n_frames, bool)
+    for pad, other in ((0, 1), (1, 0)):
+        only_guessed = ~np.isfinite(lo[pad, 0])
+        overlap = np.maximum(lo[pad, 1], lo[other, 0]) <= np.minimum(hi[pad, 1], hi[other, 0])
+        ok &= ~only_guessed | overlap
+    return ok
 
 
 # --- The detector ----------------------------------------------------------------------------
@@ -855,6 +899,7 @@ def detect_grasps(
     rng: np.random.Generator | None = None,
     timings: dict[str, float] | None = None,
     tilts: tuple[float, ...] = (0.0,),
+    guessed: np.ndarray | None = None,
 ) -> list[Grasp]:
     """Grasp candidates on `target` that keep side_clearance from `scene` (cleared_hand).
 
@@ -865,7 +910,8 @@ def detect_grasps(
     `base`; columns hand axis, closing axis, approach) and width (m), in sample order.
     timings, if given, receives the seconds spent in each stage (bench/grasp_detect_speed.py).
     tilts (rad): each sample's frame is tried turned about its closing axis by each of these
-    (`tilted_frames`); the default, no tilt, is GPD's.
+    (`tilted_frames`); the default, no tilt, is GPD's. guessed: (M,) bool, the target points
+    that were guessed (`mirrored_back`) rather than seen; see `guesses_face_seen`.
     """
     t_start = time.perf_counter()
     clock = [t_start]
@@ -899,7 +945,7 @@ def detect_grasps(
 
     # The pads' contents: target points where the pads could be. Most frames cannot pass the
     # antipodal test whatever the hand's depth and offset: they need no collision test.
-    tsid, tu, tv, nu, nv = pad_pairs(tgt, normals, samples, normal, axis, s)
+    tsid, tpid, tu, tv, nu, nv = pad_pairs(tgt, normals, samples, normal, axis, s)
     possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, s)
     live = np.flatnonzero(possible.any(axis=1))
     lap("pad_pairs")
@@ -922,8 +968,11 @@ def detect_grasps(
     lap("deepest_tips")
 
     keep = np.flatnonzero(has.reshape(len(samples), len(angles)).any(axis=1).take(tsid))
-    tu, tv, nu, nv, tsid = (x.take(keep) for x in (tu, tv, nu, nv, tsid))
-    width, ok = closing_region(tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s)
+    tu, tv, nu, nv, tsid, tpid = (x.take(keep) for x in (tu, tv, nu, nv, tsid, tpid))
+    pair_guessed = None if guessed is None else np.asarray(guessed, bool).take(tpid)
+    width, ok = closing_region(
+        tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s, pair_guessed
+    )
     lap("closing_region")
     good = np.flatnonzero(ok & has)
     poses = grasp_poses(samples, normal, axis, angles, good, offset[good], tip[good], s)

@@ -172,12 +172,16 @@ def candidates(
     target = cloud.points[seg.indices].astype(np.float64)
     if strategy == "gpd":
         normals, scene = cloud.normals[seg.indices], cloud.points
+        guessed = None
         if complete:
             back, back_normals = mirrored_back(target, normals)
+            guessed = np.r_[np.zeros(len(target), bool), np.ones(len(back), bool)]
             target, normals = np.vstack([target, back]), np.vstack([normals, back_normals])
             scene = np.vstack([scene, back])
         tilts = tuple(np.radians(settings.grasp.gpd_tilts_deg)) if tilted else (0.0,)
-        found = detect_grasps(target, normals, scene, settings.grasp, rng=rng, tilts=tilts)
+        found = detect_grasps(
+            target, normals, scene, settings.grasp, rng=rng, tilts=tilts, guessed=guessed
+        )
         seen = fingers_seen_free(found, perception.frames, settings.grasp)
         return [g for g, ok in zip(found, seen, strict=True) if ok]
     support = seg.surface.height if seg.surface is not None else None
