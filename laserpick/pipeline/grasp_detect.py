@@ -781,8 +781,8 @@ def closing_region(
         left += np.bincount(f[on_left], minlength=n_frames)
         right += np.bincount(f[on_right], minlength=n_frames)
         if guessed is not None:
-            side = np.where(on_left, 0, 1)[on_left | on_right]
             at = np.flatnonzero(on_left | on_right)
+            side = (~on_left).take(at).astype(np.int64)  # 0 left, 1 right
             contacts.append((f.take(at), side, depth.take(at), guessed.take(i.take(at))))
     width = cmax - cmin
     ok = (
@@ -812,8 +812,9 @@ def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
     lo = np.full((2, 2, n_frames), np.inf, np.float32)  # [pad, guessed, frame]
     hi = np.full((2, 2, n_frames), -np.inf, np.float32)
     for f, side, depth, g in contacts:
-        np.minimum.at(lo, (side, g.astype(np.int64), f), depth)
-        np.maximum.at(hi, (side, g.astype(np.int64), f), depth)
+        at = (side, g.astype(np.int64), f)
+        np.minimum.at(lo, at, depth)
+        np.maximum.at(hi, at, depth)
     ok = np.ones(n_frames, bool)
     for pad, other in ((0, 1), (1, 0)):
         only_guessed = ~np.isfinite(lo[pad, 0])
