@@ -20,7 +20,7 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import mujoco
 import numpy as np
@@ -97,6 +97,15 @@ class Snapshot:
     #: something), until it has driven freely for DRIVE_STOP_CLEARS; "" otherwise.
     drive_stop: str
     rtf: float  #: measured real-time factor of the loop (sim seconds per wall second)
+
+
+class Contact(NamedTuple):
+    """A contact on one of our geoms (the arm's, or what the hand holds)."""
+
+    normal: float  #: the normal force's size (N)
+    ours: int  #: our geom
+    other: int  #: the geom it touches
+    on_ours: np.ndarray  #: (3,) the contact's force on our geom (N, `world`)
 
 
 class Simulation:
@@ -463,7 +472,7 @@ class Simulation:
         if starting and not want.any():  # standing still: nothing to watch each step
             return False
         contacts = self._arm_contacts()
-        pushed = sum(f for f, _, _ in contacts)
+        pushed = self._felt(contacts)
         if starting:  # the push the drive starts from, the base still standing
             self._rest_push = pushed
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
@@ -486,7 +495,7 @@ class Simulation:
         on any motion the protective stop's limit: the UR5 controller stops every motion it
         feels pushed back that hard, planned around what it was shown or not."""
         contacts = self._arm_contacts()
-        total = sum(f for f, _, _ in contacts)
+        total = self._felt(contacts)
         if guard_force is not None and total > guard_force:
             self._halt("failed", f"unexpected contact: {self._contact_report(contacts)}")
             return True
@@ -520,12 +529,10 @@ class Simulation:
             return True
         return False
 
-    def _contacts(
-        self, geoms: np.ndarray, *, from_outside: bool = False
-    ) -> list[tuple[float, int, int]]:
-        """(normal force (N), geom among `geoms` (a mask over the model's geoms), the other
-        geom) of each contact touching any of `geoms`; from_outside: only those between one
-        of `geoms` and one not among them."""
+    def _contacts(self, geoms: np.ndarray, *, from_outside: bool = False) -> list[Contact]:
+        """Each contact touching any of `geoms` (a mask over the model's geoms), with the
+        force on our geom; from_outside: only those between one of `geoms` and one not
+        among them."""
         d = self.data
         if d.ncon == 0:
             return []
@@ -537,20 +544,22 @@ class Simulation:
         force = np.zeros(6)
         for i in np.flatnonzero((a != b) if from_outside else (a | b)):
             mujoco.mj_contactForce(self.model, d, int(i), force)
-            ours, other = pairs[i] if a[i] else pairs[i, ::-1]
-            out.append((abs(float(force[0])), int(ours), int(other)))
+            # The contact frame's first row is the normal from geom1 to geom2; the force in
+            # it acts on geom2, and its opposite on geom1.
+            on_second = d.contact.frame[i].reshape(3, 3).T @ force[:3]
+            (ours, other), on_ours = (pairs[i], -on_second) if a[i] else (pairs[i, ::-1], on_second)
+            out.append(Contact(abs(float(force[0])), int(ours), int(other), on_ours))
         return out
 
     def _gripper_force(self) -> float:
         """Force (N) on the pads: what the gripper's own current sensing reports."""
-        return sum(f for f, _, _ in self._contacts(self._pad_geoms))
+        return sum(c.normal for c in self._contacts(self._pad_geoms))
 
-    def _arm_contacts(self) -> list[tuple[float, int, int]]:
+    def _arm_contacts(self) -> list[Contact]:
         """The contacts from outside on the arm and the gripper, and on what a closed gripper
-        holds, as `_contacts` gives them: their sum is what the UR5's joint-current force
-        estimate or a wrist force sensor would read. The grip itself (the pads on the held
-        object) is internal and not counted: counted, it tripped every guarded place at once,
-        and the object was let go from 10 cm up."""
+        holds, as `_contacts` gives them (`_felt` says what they add up to). The grip itself
+        (the pads on the held object) is internal and not counted: counted, it tripped every
+        guarded place at once, and the object was let go from 10 cm up."""
         if not self._grip_closed or self.data.ncon == 0:
             return self._contacts(self._arm_geoms)
         m, pairs = self.model, self.data.contact.geom
@@ -562,15 +571,28 @@ class Simulation:
         held = np.isin(m.geom_bodyid, m.geom_bodyid[touched])
         return self._contacts(self._arm_geoms | held, from_outside=True)
 
-    def _contact_report(self, contacts: list[tuple[float, int, int]]) -> str:
+    def _felt(self, contacts: list[Contact]) -> float:
+        """What the UR5's joint-current force estimate, or a wrist force sensor, reads of
+        `contacts` (N): the forces on each body of the arm (and on what the hand holds) added
+        as vectors, and the bodies' net forces' sizes added up. Sizes added contact by contact
+        read 21 kN where an opened finger had gone through a mug's handle and the solver
+        pressed it from both sides at once: forces that cancel in the finger, and that no
+        sensor would feel."""
+        if not contacts:
+            return 0.0
+        body = self.model.geom_bodyid[[c.ours for c in contacts]]
+        net = np.zeros((self.model.nbody, 3))
+        np.add.at(net, body, np.array([c.on_ours for c in contacts]))
+        return float(np.linalg.norm(net[np.unique(body)], axis=1).sum())
+
+    def _contact_report(self, contacts: list[Contact]) -> str:
         """'{N} N on the arm, most where {body} met {body}': what a guarded stop says."""
-        _, ours, other = max(contacts)
+        worst = max(contacts, key=lambda c: c.normal)
         body = self.model.geom_bodyid
         ours_name, other_name = (
-            self.model.body(int(body[g])).name or "the world" for g in (ours, other)
+            self.model.body(int(body[g])).name or "the world" for g in (worst.ours, worst.other)
         )
-        total = sum(f for f, _, _ in contacts)
-        return f"{total:.0f} N on the arm, most where {ours_name} met {other_name}"
+        return f"{self._felt(contacts):.0f} N on the arm, most where {ours_name} met {other_name}"
 
     def _publish(self) -> None:
         d, info = self.data, self.info
