@@ -194,7 +194,7 @@ def test_a_can_laid_on_its_side_stays_on_its_table():
 
 
 def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
-    """`_contacts` gives the force on our geom: an object resting on its table is pushed up
+    """`_contacts` gives the normal force on our geom: an object resting on its table is pushed up
     by its weight. `_felt` adds forces as vectors within a body (a finger pressed from both
     sides at once feels nothing net) and their sizes across bodies."""
     from laserpick.robot.sim import Contact

@@ -105,7 +105,7 @@ class Contact(NamedTuple):
     normal: float  #: the normal force's size (N)
     ours: int  #: our geom
     other: int  #: the geom it touches
-    on_ours: np.ndarray  #: (3,) the contact's force on our geom (N, `world`)
+    on_ours: np.ndarray  #: (3,) the contact's normal force on our geom (N, `world`)
 
 
 class Simulation:
@@ -544,9 +544,9 @@ class Simulation:
         force = np.zeros(6)
         for i in np.flatnonzero((a != b) if from_outside else (a | b)):
             mujoco.mj_contactForce(self.model, d, int(i), force)
-            # The contact frame's first row is the normal from geom1 to geom2; the force in
-            # it acts on geom2, and its opposite on geom1.
-            on_second = d.contact.frame[i].reshape(3, 3).T @ force[:3]
+            # The contact frame's first row is the normal from geom1 to geom2: the normal
+            # force pushes geom2 along it, and geom1 the other way.
+            on_second = d.contact.frame[i, :3] * force[0]
             (ours, other), on_ours = (pairs[i], -on_second) if a[i] else (pairs[i, ::-1], on_second)
             out.append(Contact(abs(float(force[0])), int(ours), int(other), on_ours))
         return out
@@ -573,11 +573,13 @@ class Simulation:
 
     def _felt(self, contacts: list[Contact]) -> float:
         """What the UR5's joint-current force estimate, or a wrist force sensor, reads of
-        `contacts` (N): the forces on each body of the arm (and on what the hand holds) added
-        as vectors, and the bodies' net forces' sizes added up. Sizes added contact by contact
-        read 21 kN where an opened finger had gone through a mug's handle and the solver
-        pressed it from both sides at once: forces that cancel in the finger, and that no
-        sensor would feel."""
+        `contacts` (N): the normal forces on each body of the arm (and on what the hand
+        holds) added as vectors, and the bodies' net forces' sizes added up. Sizes added
+        contact by contact read 21 kN where an opened finger had gone through a mug's handle
+        and the solver pressed it from both sides at once: forces that cancel in the finger,
+        and that no sensor would feel. Friction is left out, as when the guards' limits (25
+        N on an approach, 150 N anywhere) were set: with it, a finger brushing a mug's handle
+        on the way in read 25-28 N, and the guard stopped three approaches in a row."""
         if not contacts:
             return 0.0
         body = self.model.geom_bodyid[[c.ours for c in contacts]]
