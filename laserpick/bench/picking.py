@@ -352,23 +352,22 @@ class ScriptedOperator:
     def tidy(self) -> None:
         """Reset what an attempt left: every object in the basket is taken out of the scene
         (the fetched one, or another a wrong grasp dropped there: it would stand in the beam's
-        way), so is an object still in the hand, taken from it before it opens (let go, a
-        cereal box fell back onto the shelf, and the stow swept the hand into it), and the arm
-        is stowed around a fresh capture, as the session stows (around an empty cloud it met
-        a bookshelf's board), or moved home by hand where it is stuck; the session is told."""
+        way), so is an object still in the hand, a stuck arm is moved home by hand, and the
+        session is told."""
         s, robot = self.session, self.robot
         for name in self.referee.instances():
             if self.referee.in_basket(name):
                 self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
-            if s.behaviours.held is not None:
+            held = s.behaviours.held
+            robot.gripper(False)
+            robot.sleep(1.0)
+            if held is not None:
                 for name in self.referee.instances():
                     if self.referee.near_hand(name):
                         self.referee.take_out(name)
-            robot.gripper(False)
-            robot.sleep(1.0)
         if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
-            out = s.behaviours.stow(s.surroundings()) if not robot.gripper_state().closed else None
+            out = s.behaviours.stow() if not robot.gripper_state().closed else None
             if out is None or not out.ok:
                 self.referee.move_arm_home()
         s.resync(BENCH)

@@ -920,7 +920,7 @@ class Session:
             return
         self._stow_and_rest("Placed.")
 
-    def surroundings(self) -> CollisionChecker | None:
+    def _surroundings(self) -> CollisionChecker | None:
         """What stands around the arm now, from a fresh capture: the way home is planned
         around it (a stow planned around an empty cloud put the hand into the 87 cm counter
         on its way to the ready pose). The arm's own points are left out, and the space it
@@ -942,7 +942,7 @@ class Session:
         )
 
     def _stow_and_rest(self, message: str) -> None:
-        out = self.behaviours.stow(self.surroundings())
+        out = self.behaviours.stow(self._surroundings())
         with self._lock:
             self.task = _Task()
             self._projection = None
@@ -974,7 +974,7 @@ class Session:
                 self.robot.sleep(GRIPPER_TIME)
             b.held = None
             self._progress("Returning the arm.")
-            b.stow(self.surroundings())
+            b.stow(self._surroundings())
         with self._lock:
             if cancelled:
                 self._cancel.set()  # so the journal records the job as cancelled
