@@ -579,7 +579,7 @@ class Simulation:
         and the solver pressed it from both sides at once: forces that cancel in the finger,
         and that no sensor would feel. Friction is left out, as when the guards' limits (25
         N on an approach, 150 N anywhere) were set: with it, a finger brushing a mug's handle
-        on the way in read 25-28 N, and the guard stopped three approaches in a row."""
+        on the way in read 25-28 N, and the guard stopped approaches it had let through."""
         if not contacts:
             return 0.0
         body = self.model.geom_bodyid[[c.ours for c in contacts]]
