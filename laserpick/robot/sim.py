@@ -477,7 +477,7 @@ class Simulation:
             self._rest_push = pushed
         if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
             return False
-        self._drive_stop = f"{DRIVE_STOP} ({self._contact_report(contacts)})."
+        self._drive_stop = f"{DRIVE_STOP} ({self._contact_report(contacts, pushed)})."
         if self.data.time - self._push_reported > 1.0:  # once a second, not every step
             log.warning(self._drive_stop)
             self._push_reported = self.data.time
@@ -497,10 +497,10 @@ class Simulation:
         contacts = self._arm_contacts()
         total = self._felt(contacts)
         if guard_force is not None and total > guard_force:
-            self._halt("failed", f"unexpected contact: {self._contact_report(contacts)}")
+            self._halt("failed", f"unexpected contact: {self._contact_report(contacts, total)}")
             return True
         if total > dims.UR5_PROTECTIVE_STOP_FORCE:
-            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts))
+            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts, total))
             return True
         return False
 
@@ -530,8 +530,8 @@ class Simulation:
         return False
 
     def _contacts(self, geoms: np.ndarray, *, from_outside: bool = False) -> list[Contact]:
-        """Each contact touching any of `geoms` (a mask over the model's geoms), with the
-        force on our geom; from_outside: only those between one of `geoms` and one not
+        """Each contact touching any of `geoms` (a mask over the model's geoms), with its
+        normal force on our geom; from_outside: only those between one of `geoms` and one not
         among them."""
         d = self.data
         if d.ncon == 0:
@@ -587,14 +587,15 @@ class Simulation:
         np.add.at(net, body, np.array([c.on_ours for c in contacts]))
         return float(np.linalg.norm(net[np.unique(body)], axis=1).sum())
 
-    def _contact_report(self, contacts: list[Contact]) -> str:
-        """'{N} N on the arm, most where {body} met {body}': what a guarded stop says."""
+    def _contact_report(self, contacts: list[Contact], felt: float) -> str:
+        """'{N} N on the arm, most where {body} met {body}': what a guarded stop says, with
+        `felt` (N) the `_felt` force that stopped it."""
         worst = max(contacts, key=lambda c: c.normal)
         body = self.model.geom_bodyid
         ours_name, other_name = (
             self.model.body(int(body[g])).name or "the world" for g in (worst.ours, worst.other)
         )
-        return f"{self._felt(contacts):.0f} N on the arm, most where {ours_name} met {other_name}"
+        return f"{felt:.0f} N on the arm, most where {ours_name} met {other_name}"
 
     def _publish(self) -> None:
         d, info = self.data, self.info
