@@ -273,7 +273,7 @@ def test_viser_websocket_through_the_proxy(stack: Stack, path: str) -> None:
     protocol = f"viser-v{viser_version}"
     url = f"wss://127.0.0.1:{stack.https_port}{path}"
     # Generous timeouts: the handshake passes the proxy and a server process that may still
-    # be busy; with two benches on this machine's two cores it took more than 10 s once.
+    # be busy; beside a two-worker bench on this machine's two cores it took over 10 s once.
     with connect(
         url, ssl=stack.tls, subprotocols=[protocol], open_timeout=30, close_timeout=2
     ) as ws:
