@@ -26,7 +26,12 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.collision import CollisionChecker, carried_shape, obstacle_mask
+from laserpick.pipeline.collision import (
+    CollisionChecker,
+    carried_shape,
+    obstacle_mask,
+    surface_front,
+)
 from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
@@ -792,7 +797,16 @@ class Behaviours:
         failure = self._rise_clear(around, hand_on_the_way=False)
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot)
-        back = self.stow(around)
+        # First with the surface's front walled in below its near edge (`surface_front`),
+        # then around what was seen and the object alone.
+        front = surface_front(seen, float(spot[2]), PLACE_SURFACE_BAND)
+        front = front[obstacle_mask(front, voxel=0.0)]
+        walled = CollisionChecker(
+            np.vstack([around.points, front]), margin=s.clearance, filtered=True
+        )
+        back = self.stow(walled)
+        if back.failure is not None and back.failure.kind == "ik_plan" and len(front):
+            back = self.stow(around)
         if back.failure is not None and back.failure.kind == "ik_plan":
             # The object as held stands for more than it is (a plush toy's mirrored back):
             # the hand drawn 5 cm back out of one still stood 2 mm inside it, and no way

@@ -215,6 +215,31 @@ def carried_shape(
     return both[thin(both, voxel)]
 
 
+def surface_front(
+    points: np.ndarray, height: float, band: float, voxel: float = CARRIED_VOXEL
+) -> np.ndarray:
+    """Points (m, `base`) that stand for the front of a surface the cameras saw from above: a
+    wall across the whole width they saw of it, as near to the robot as the nearest of its
+    top they saw, from `height` (m) down to the floor's clearance, a point per `voxel` (m).
+
+    points (N, 3), `base`: the cloud; those within `band` (m) of `height` are the surface's
+    top. The cameras look down and ahead, so a counter's front runs out of their view before
+    its top does, and its near edge with it (the view's edge cuts the top on a slant): a
+    stow planned around what they saw swung the upper arm into the 87 cm counter's unseen
+    front (203 N), 13 cm nearer than the seen top's edge there. A table is open below its
+    edge and a round one's edge curves away; the arm has no business under either, so the
+    wall only makes the planner more careful there."""
+    points = np.asarray(points, float).reshape(-1, 3)
+    top = points[np.abs(points[:, 2] - height) < band]
+    z = np.arange(height - voxel, FLOOR_CLEARANCE, -voxel)
+    if len(top) == 0 or len(z) == 0:
+        return np.zeros((0, 3))
+    y = np.arange(top[:, 1].min(), top[:, 1].max() + voxel, voxel)
+    return np.column_stack(
+        [np.full(len(y) * len(z), top[:, 0].min()), np.repeat(y, len(z)), np.tile(z, len(y))]
+    )
+
+
 def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.ndarray:
     """Mask (N,) of the points that are not the arm itself at joint angles q (6,): a real
     robot's self filter, so the planner does not take its own arm for an obstacle.
