@@ -11,7 +11,7 @@ import pytest
 from pydantic import ValidationError
 
 from laserpick.description import dims
-from laserpick.description.collision import KEEPOUT_BOXES, body_frames
+from laserpick.description.collision import FLOOR_CLEARANCE, KEEPOUT_BOXES, body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import (
@@ -21,6 +21,7 @@ from laserpick.pipeline.collision import (
     carried_shape,
     self_filter,
     sphere_centres,
+    surface_front,
     thin,
 )
 from laserpick.pipeline.plan import (
@@ -180,6 +181,33 @@ def test_carried_shape_fills_in_the_unseen_back_of_a_can():
     filled = carried_shape(upper, support=0.46)
     assert filled[:, 2].min() < 0.46 + 0.02
     assert np.all(np.abs(filled[:, :2] - axis).max(axis=1) < r + 0.03)  # within the footprint
+
+
+def test_surface_front_walls_in_a_counter_front_the_view_cut_off():
+    """An 87 cm counter whose front stands at x = 1.40 m: the cameras saw its top to
+    y = -0.8 m, but right of y = -0.5 m the view's edge cuts the top on a slant (the top's
+    nearest seen point there lies up to 30 cm deeper) and the front below it is not seen.
+    The wall must stand at the nearest seen edge across the whole seen width, from just
+    under the top down to the floor's clearance, where the upper arm met the unseen front."""
+    xs, ys = np.meshgrid(np.arange(1.40, 2.0, 0.01), np.arange(-0.8, 0.38, 0.01))
+    top = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 0.87)]
+    top = top[top[:, 0] >= 1.40 + np.maximum(0.0, -0.5 - top[:, 1])]  # the slanted view edge
+    fy, fz = np.meshgrid(np.arange(-0.5, 0.38, 0.01), np.arange(0.6, 0.86, 0.01))
+    face = np.c_[np.full(fy.size, 1.40), fy.ravel(), fz.ravel()]
+    mug = np.c_[np.full(10, 1.7), np.full(10, 0.1), np.linspace(0.87, 0.97, 10)]
+    cloud = np.vstack([top, face, mug])
+    wall = surface_front(cloud, 0.87, 0.015)
+    assert np.allclose(wall[:, 0], 1.40)
+    assert wall[:, 1].min() == pytest.approx(top[:, 1].min(), abs=1e-9)
+    assert top[:, 1].max() <= wall[:, 1].max() <= top[:, 1].max() + 0.02 + 1e-9
+    assert np.diff(np.unique(wall[:, 1])).max() <= 0.02 + 1e-9
+    assert wall[:, 2].max() < 0.87 - 0.015  # below the top, which the hand may set things on
+    assert wall[:, 2].min() >= FLOOR_CLEARANCE
+    upper_arm = np.array([1.36, -0.58, 0.84])  # where the stow's upper arm met the counter
+    assert np.linalg.norm(cloud - upper_arm, axis=1).min() > 0.06  # its 6 cm sphere: clear
+    assert np.linalg.norm(wall - upper_arm, axis=1).min() < 0.06  # not of the wall
+    assert len(surface_front(cloud, 0.0, 0.015)) == 0  # the floor has no front
+    assert len(surface_front(cloud, 0.5, 0.015)) == 0  # nothing seen at that height
 
 
 def test_self_filter_removes_the_arm_and_keeps_the_rest():
