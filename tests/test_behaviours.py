@@ -18,6 +18,7 @@ from laserpick.behaviours import (
     SUPPORT_SCATTER,
     Behaviours,
     Held,
+    Outcome,
     drop_candidates,
     turned_hand_xy,
 )
@@ -28,7 +29,13 @@ from laserpick.description import dims
 from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.collision import SPHERES, CollisionChecker, carried_shape, sphere_centres
+from laserpick.pipeline.collision import (
+    SPHERES,
+    CollisionChecker,
+    carried_shape,
+    obstacle_mask,
+    sphere_centres,
+)
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
@@ -330,9 +337,29 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
         gripper(close)
 
     robot.gripper = recording_gripper  # type: ignore[method-assign]
-    out = b.place(fuse(frames), mark)
+    stows: list[CollisionChecker] = []
+    stow = b.stow
+
+    def recording_stow(checker: CollisionChecker | None = None) -> Outcome:
+        stows.append(checker)
+        return stow(checker)
+
+    b.stow = recording_stow  # type: ignore[method-assign]
+    cloud = fuse(frames)
+    out = b.place(cloud, mark)
     robot.gripper = gripper  # type: ignore[method-assign]
     assert out.ok, out.failure
+    # The stow went around a wall under the table's front (`surface_front`), at the nearest
+    # of its top the cameras saw, down to the floor, where they saw little of the table.
+    seen = cloud.points[obstacle_mask(cloud.points)]
+    edge = seen[np.abs(seen[:, 2] - TABLE_TOP) < 0.01][:, 0].min()
+
+    def under_the_edge(points: np.ndarray) -> int:
+        near = np.abs(points[:, 0] - edge) < 0.02
+        return int(np.sum(near & (points[:, 2] > 0.05) & (points[:, 2] < TABLE_TOP - 0.05)))
+
+    assert stows and stows[0] is not None
+    assert under_the_edge(stows[0].points) > under_the_edge(seen) + 500
     assert let_go_at and let_go_at[0] - TABLE_TOP < 0.003, f"let go {let_go_at} m up"
     assert out.spot is not None and abs(out.spot[2] - TABLE_TOP) < 0.01
     assert not robot.gripper_state().closed
