@@ -797,8 +797,8 @@ class Behaviours:
         failure = self._rise_clear(around, hand_on_the_way=False)
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot)
-        # First with the surface's front walled in below its near edge (`surface_front`),
-        # then around what was seen and the object alone.
+        # First around a wall under the surface's seen front (`surface_front`: a counter's
+        # front runs out of the cameras' view before its top does), then without it.
         front = surface_front(seen, float(spot[2]), PLACE_SURFACE_BAND)
         front = front[obstacle_mask(front, voxel=0.0)]
         walled = CollisionChecker(

@@ -226,9 +226,9 @@ def surface_front(
     top. The cameras look down and ahead, so a counter's front runs out of their view before
     its top does, and its near edge with it (the view's edge cuts the top on a slant): a
     stow planned around what they saw swung the upper arm into the 87 cm counter's unseen
-    front (203 N), about 20 cm nearer than the seen top's edge there. A table is open below its
-    edge and a round one's edge curves away; the arm has no business under either, so the
-    wall only makes the planner more careful there."""
+    front (203 N), about 20 cm nearer than the seen top's edge there. A table is open below
+    its edge and a round one's edge curves away; the arm has no business under either, so
+    the wall only makes the planner more careful there."""
     points = np.asarray(points, float).reshape(-1, 3)
     top = points[np.abs(points[:, 2] - height) < band]
     z = np.arange(height - voxel, FLOOR_CLEARANCE, -voxel)
