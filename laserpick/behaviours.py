@@ -122,6 +122,7 @@ def turned_hand_xy(spot_xy: np.ndarray, middle_xy: np.ndarray, dyaw: float) -> n
 class Outcome:
     """How a behaviour ended. attempts: grasps tried in planning; timings: seconds per stage;
     spot: where a place set the object down (the surface point under the TCP, m, `base`);
+    standing: the object there as the hand let it go (its carried shape, m, `base`);
     closed_width: a pick's finger gap once it has squeezed again after the first lift (m),
     beside `grasp.width`, the width it planned: an object turned in the pads shows less."""
 
@@ -130,6 +131,7 @@ class Outcome:
     attempts: int = 0
     timings: dict[str, float] = field(default_factory=dict)
     spot: np.ndarray | None = None
+    standing: np.ndarray | None = None
     closed_width: float | None = None
 
     @property
@@ -818,7 +820,7 @@ class Behaviours:
             failure = Failure(back.failure.kind, f"Set down; then {msg[:1].lower()}{msg[1:]}")
             return Outcome(failure, held.grasp, spot=spot)
         self.progress("Placed.")
-        return Outcome(None, held.grasp, spot=spot)
+        return Outcome(None, held.grasp, spot=spot, standing=standing)
 
     def _leave_placed(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
         """Take the open hand off what it has just set down: drawn back along its approach

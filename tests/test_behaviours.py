@@ -34,12 +34,14 @@ from laserpick.pipeline.collision import (
     CollisionChecker,
     carried_shape,
     obstacle_mask,
+    self_filter,
     sphere_centres,
 )
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
 from laserpick.pipeline.selection import group, score
+from laserpick.pipeline.surface import still_standing
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, Grasp
 from laserpick.robot.scenes import load_scene
@@ -370,6 +372,23 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     assert np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) < 0.05
     up = matrix_from_quat(referee.world_quat(name)) @ up0
     assert up[2] > np.cos(np.radians(15)), "it should stand as it stood"
+    # The place's post-condition, from what the cameras see with the arm gone: it stands
+    # there; laid on its side 12 cm farther in, the spot is bare, and it does not.
+    assert out.standing is not None
+
+    def seen_now() -> np.ndarray:
+        points = fuse(robot.capture()).points
+        return points[self_filter(points, robot.joint_state().q)]
+
+    assert still_standing(seen_now(), out.standing, float(out.spot[2])) is True
+    lying = referee.free_joint(name)
+    lying[0] += 0.12
+    lying[2] += 0.02
+    lying[3:] = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # a quarter turn about x
+    referee.put_back(name, lying)
+    robot.sleep(1.0)
+    assert matrix_from_quat(referee.world_quat(name))[2, 2] < 0.5  # on its side
+    assert still_standing(seen_now(), out.standing, float(out.spot[2])) is False
 
 
 def test_what_the_cameras_see_now_has_the_objects_and_not_the_arm(robot):

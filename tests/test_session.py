@@ -7,10 +7,11 @@ import time
 
 import numpy as np
 
+from laserpick.behaviours import Outcome
 from laserpick.bench.operator import Referee
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.server.session import Actor, Session, TaskState
+from laserpick.server.session import PLACED_NOT_STANDING, Actor, Session, TaskState
 
 
 def test_a_click_confirmed_mark_is_perceived_in_the_cloud_it_was_aimed_in() -> None:
@@ -180,3 +181,24 @@ def test_a_second_click_on_the_dot_confirms_though_a_new_capture_sees_otherwise(
         console.stop()
         session.close()
         server.stop()
+
+
+def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there() -> None:
+    """The place's post-condition (EL-E 000 section 6), from the capture the stow after it
+    takes: an object standing where the hand let it go is "Placed."; where the cameras see
+    the surface bare instead (the opened hand took it along, say), the user hears so."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        referee = Referee(session.robot)
+        standing = referee.object_points("mug_1")  # as a place would have let it go
+        spot = np.array([*standing[:, :2].mean(axis=0), standing[:, 2].min()])
+        placed = Outcome(spot=spot, standing=standing)
+        session._stow_and_rest("Placed.", placed=placed)
+        assert session.state == TaskState.IDLE
+        assert session.failure is None and session.message == "Placed. Ready."
+        referee.take_out("mug_1")
+        session._stow_and_rest("Placed.", placed=placed)
+        assert session.state == TaskState.IDLE
+        assert session.failure is not None and session.failure.message == PLACED_NOT_STANDING
+    finally:
+        session.close()

@@ -8,7 +8,12 @@ import pytest
 
 from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.surface import is_flat_surface, place_target, surface_height
+from laserpick.pipeline.surface import (
+    is_flat_surface,
+    place_target,
+    still_standing,
+    surface_height,
+)
 from laserpick.pipeline.types import Failure, FusedCloud
 from laserpick.settings import PerceptionSettings
 
@@ -111,3 +116,27 @@ def test_place_off_a_surface_fails(surfaces):
     got = place_target(cloud, air, SETTINGS)
     assert isinstance(got, Failure) and got.kind == "precondition"
     assert got.message == "that spot is not on a flat surface"
+
+
+def test_still_standing_says_so_only_from_what_it_sees():
+    """A 12 cm can set down on a 73 cm table: its seen front and top standing there (True);
+    the same can lying there, 6.6 cm high, and the table bare (False); nothing seen at the
+    spot, or only a few stray points (None)."""
+    top, r, h = 0.73, 0.033, 0.12
+    ring = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    zs = np.arange(0.0, h + 1e-9, 0.01)
+    can = np.vstack([np.c_[r * np.cos(ring), r * np.sin(ring), np.full(24, z)] for z in zs])
+    standing = can + [1.5, -0.3, top]
+    xs, ys = np.meshgrid(np.arange(1.3, 1.7, 0.005), np.arange(-0.5, -0.1, 0.005))
+    table = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, top)]
+    bare = table[np.hypot(table[:, 0] - 1.5, table[:, 1] + 0.3) > r]  # hidden under it
+    front = standing[standing[:, 0] <= 1.5]  # what cameras in front see of it
+    assert still_standing(np.vstack([bare, front]), standing, top) is True
+    lying = np.c_[can[:, 2] - h / 2, can[:, 1], can[:, 0] + r] + [1.5, -0.3, top]
+    under = (np.abs(table[:, 0] - 1.5) <= h / 2) & (np.abs(table[:, 1] + 0.3) <= r)
+    assert still_standing(np.vstack([table[~under], lying]), standing, top) is False
+    assert still_standing(table, standing, top) is False
+    assert still_standing(np.zeros((0, 3)), standing, top) is None
+    far = table[np.hypot(table[:, 0] - 1.5, table[:, 1] + 0.3) > 0.1]
+    assert still_standing(far, standing, top) is None
+    assert still_standing(np.vstack([far, front[:5]]), standing, top) is None

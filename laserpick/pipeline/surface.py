@@ -10,12 +10,24 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 from laserpick.pipeline.types import Failure, FusedCloud
 from laserpick.settings import PerceptionSettings
 
 #: 8-connectivity in a 2D grid (000 4.3.2).
 _EIGHT = np.ones((3, 3), bool)
+#: A placed object's footprint: the level positions within this (m) of its points' own.
+FOOTPRINT_PAD = 0.01
+#: Points (m) within this of a surface's height are the surface, not what stands on it.
+SURFACE_BAND = 0.015
+#: An object still stands where it was set down when points within its footprint rise to
+#: this fraction of its height above the surface: an upright object's top is what the
+#: cameras see best; one lying on its side reaches about its girth (a pill bottle 8 cm tall,
+#: 4 cm round, half its height).
+STANDING_FRACTION = 0.6
+#: Fewest points that count as seeing something there: a top, or the bare surface.
+SEEN_POINTS = 10
 
 
 def voi_mask(points: np.ndarray, center: np.ndarray, settings: PerceptionSettings) -> np.ndarray:
@@ -189,3 +201,28 @@ def place_target(
     if edge is not None and x - edge < settings.place_edge_margin:
         x = edge + settings.place_edge_margin
     return np.array([x, y, z_top], np.float32)
+
+
+def still_standing(points: np.ndarray, standing: np.ndarray, surface_z: float) -> bool | None:
+    """The place's post-condition (EL-E 000 section 6: a behaviour that knows whether it
+    succeeded): whether an object set down still stands where it was let go, by what the
+    cameras see once the arm has gone.
+
+    points: the cloud now (m, `base`), the arm's own points left out; standing: the object
+    as it was let go (its carried shape, m, `base`); surface_z: the height (m) of the
+    surface it was set on. True when SEEN_POINTS or more rise within its footprint (its
+    level extent, FOOTPRINT_PAD wider) to STANDING_FRACTION of its height above the surface.
+    False when the cameras see the surface bare there instead: SEEN_POINTS or more of it
+    within the footprint and nothing that high (it fell over, or the hand took it along).
+    None when they see neither (something stands in their way): nothing is known.
+    """
+    height = float(standing[:, 2].max()) - surface_z
+    if len(points) == 0 or height <= SURFACE_BAND:
+        return None
+    d, _ = cKDTree(standing[:, :2]).query(points[:, :2], distance_upper_bound=FOOTPRINT_PAD)
+    above = points[np.isfinite(d), 2] - surface_z
+    if np.count_nonzero(above >= STANDING_FRACTION * height) >= SEEN_POINTS:
+        return True
+    if np.count_nonzero(np.abs(above) < SURFACE_BAND) >= SEEN_POINTS:
+        return False
+    return None

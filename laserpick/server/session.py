@@ -43,16 +43,17 @@ from typing import Any, Literal
 
 import numpy as np
 
-from laserpick.behaviours import GRIPPER_TIME, Behaviours
+from laserpick.behaviours import GRIPPER_TIME, Behaviours, Outcome
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse, ray_hit
-from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.collision import CollisionChecker, self_filter
 from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.recall import Recalled, ViewMemory
 from laserpick.pipeline.selection import GraspCursor
+from laserpick.pipeline.surface import still_standing
 from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
 from laserpick.robot.scenes import Scene
 from laserpick.robot.sim_robot import SimRobot
@@ -72,6 +73,11 @@ Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
 
 
 ESTOP_REASON = "Stopped by the e-stop; the arm stays where it is."
+#: What the user hears when a place's post-condition fails (`_fell`).
+PLACED_NOT_STANDING = (
+    "I set the object down, but it is not standing where I let go of it: it may have fallen"
+    " over. Mark it again to pick it up."
+)
 #: The watchdog's period (s), and the gap between its ticks that means the process stalled.
 WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
 #: Longest the API's event loop may lag (s) before the watchdog judges silence regardless.
@@ -918,19 +924,24 @@ class Session:
             assert out.failure is not None
             self._end_badly(out.failure)
             return
-        self._stow_and_rest("Placed.")
+        self._stow_and_rest("Placed.", placed=out)
 
-    def _surroundings(self) -> CollisionChecker | None:
-        """What stands around the arm now, from a fresh capture: the way home is planned
+    def _try_look(self) -> _Capture | None:
+        """A new capture, or None if the cameras fail (logged)."""
+        try:
+            return self._look()
+        except Exception:
+            log.exception("No capture; going on without one.")
+            return None
+
+    def _surroundings(self, capture: _Capture | None) -> CollisionChecker | None:
+        """What stands around the arm in `capture`, a fresh one: the way home is planned
         around it (a stow planned around an empty cloud put the hand into the 87 cm counter
         on its way to the ready pose). The arm's own points are left out, and the space it
         fills counts as seen; the views kept on the way in add what they saw where no camera
-        sees now. None when the cameras fail: the arm must still go home, as
-        it did before it looked (rising first, `Behaviours.go_ready`)."""
-        try:
-            capture = self._look()
-        except Exception:
-            log.exception("No capture before stowing; stowing without one.")
+        sees now. None without a capture (the cameras failed): the arm must still go home,
+        as it did before it looked (rising first, `Behaviours.go_ready`)."""
+        if capture is None:
             return None
         recalled = self._recalled()
         blind = recalled.blind_points(capture.frames)
@@ -941,16 +952,32 @@ class Session:
             frames=(*capture.frames, *recalled.frames),
         )
 
-    def _stow_and_rest(self, message: str) -> None:
-        out = self.behaviours.stow(self._surroundings())
+    def _stow_and_rest(self, message: str, placed: Outcome | None = None) -> None:
+        """Stow and rest, saying `message`; after a place (`placed`), first check from the
+        same capture that the object still stands where it was let go."""
+        capture = self._try_look()
+        fell = placed is not None and capture is not None and self._fell(capture, placed)
+        out = self.behaviours.stow(self._surroundings(capture))
         with self._lock:
             self.task = _Task()
             self._projection = None
-            if out.ok:
+            if fell:
+                self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
+            elif out.ok:
                 self._set(TaskState.IDLE, f"{message} Ready.")
             else:
                 assert out.failure is not None
                 self._fail(out.failure, TaskState.IDLE)
+
+    def _fell(self, capture: _Capture, placed: Outcome) -> bool:
+        """Whether the cameras see the surface bare where the place let the object go: it
+        fell over, or the opened hand took it along (a pill bottle that clung to a pad rose
+        4.6 cm with it and fell on its side). Nothing is said where they cannot tell."""
+        if placed.standing is None or placed.spot is None:
+            return False
+        points = capture.cloud.points
+        points = points[self_filter(points, self.robot.joint_state().q)]
+        return still_standing(points, placed.standing, float(placed.spot[2])) is False
 
     def _end_badly(self, failure: Failure) -> None:
         """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
@@ -974,7 +1001,7 @@ class Session:
                 self.robot.sleep(GRIPPER_TIME)
             b.held = None
             self._progress("Returning the arm.")
-            b.stow(self._surroundings())
+            b.stow(self._surroundings(self._try_look()))
         with self._lock:
             if cancelled:
                 self._cancel.set()  # so the journal records the job as cancelled
