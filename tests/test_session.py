@@ -9,6 +9,7 @@ import numpy as np
 
 from laserpick.behaviours import Outcome
 from laserpick.bench.operator import Referee
+from laserpick.pipeline.types import Failure
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
 from laserpick.server.session import PLACED_NOT_STANDING, Actor, Session, TaskState
@@ -200,5 +201,11 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         session._stow_and_rest("Placed.", placed=placed)
         assert session.state == TaskState.IDLE
         assert session.failure is not None and session.failure.message == PLACED_NOT_STANDING
+        # Where the arm then fails to get home too, that is said first, and the fall with it.
+        stuck = Outcome(Failure("ik_plan", "No way home was found."))
+        session.behaviours.stow = lambda checker=None: stuck  # type: ignore[method-assign]
+        session._stow_and_rest("Placed.", placed=placed)
+        assert session.failure is not None and session.failure.kind == "ik_plan"
+        assert session.failure.message == f"No way home was found. {PLACED_NOT_STANDING}"
     finally:
         session.close()

@@ -961,13 +961,14 @@ class Session:
         with self._lock:
             self.task = _Task()
             self._projection = None
-            if fell:
-                self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
-            elif out.ok:
+            if out.ok and not fell:
                 self._set(TaskState.IDLE, f"{message} Ready.")
-            else:
+            elif out.ok:
+                self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
+            else:  # the arm not home is said first; a fall, where seen, with it
                 assert out.failure is not None
-                self._fail(out.failure, TaskState.IDLE)
+                said = f"{out.failure.message} {PLACED_NOT_STANDING}" if fell else None
+                self._fail(Failure(out.failure.kind, said or out.failure.message), TaskState.IDLE)
 
     def _fell(self, capture: _Capture, placed: Outcome) -> bool:
         """Whether the cameras see the surface bare where the place let the object go: it
