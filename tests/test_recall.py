@@ -198,7 +198,7 @@ def test_the_blind_spot_beside_the_parked_scooter_was_seen_on_the_way_in():
         # ready, the arm finds the place it folds into free in what the stow plans around.
         assert not self_filter(fuse(frames).points, q_home).all()
         assert session.behaviours.go_ready().ok
-        around = session._surroundings()
+        around = session._surroundings(session._try_look())
         assert around is not None and around.clearance_ok(q_home)[0]
         # With the arm away from its stowed pose, driving keeps no view.
         session.views.clear()
