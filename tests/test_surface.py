@@ -120,8 +120,9 @@ def test_place_off_a_surface_fails(surfaces):
 
 def test_still_standing_says_so_only_from_what_it_sees():
     """A 12 cm can set down on a 73 cm table: its seen front and top standing there (True);
-    the same can lying there, 6.6 cm high, and the table bare (False); nothing seen at the
-    spot, or only a few stray points (None)."""
+    rolled off the spot, or the table bare there (False); lying on the spot, 6.6 cm high
+    (None: something is there, lower than expected); nothing seen at the spot, or only a
+    few stray points (None)."""
     top, r, h = 0.73, 0.033, 0.12
     ring = np.linspace(0, 2 * np.pi, 24, endpoint=False)
     zs = np.arange(0.0, h + 1e-9, 0.01)
@@ -134,7 +135,10 @@ def test_still_standing_says_so_only_from_what_it_sees():
     assert still_standing(np.vstack([bare, front]), standing, top) is True
     lying = np.c_[can[:, 2] - h / 2, can[:, 1], can[:, 0] + r] + [1.5, -0.3, top]
     under = (np.abs(table[:, 0] - 1.5) <= h / 2) & (np.abs(table[:, 1] + 0.3) <= r)
-    assert still_standing(np.vstack([table[~under], lying]), standing, top) is False
+    assert still_standing(np.vstack([table[~under], lying]), standing, top) is None
+    rolled = lying + [0.0, -0.12, 0.0]  # off the spot
+    under = (np.abs(table[:, 0] - 1.5) <= h / 2) & (np.abs(table[:, 1] + 0.42) <= r)
+    assert still_standing(np.vstack([table[~under], rolled]), standing, top) is False
     assert still_standing(table, standing, top) is False
     assert still_standing(np.zeros((0, 3)), standing, top) is None
     far = table[np.hypot(table[:, 0] - 1.5, table[:, 1] + 0.3) > 0.1]

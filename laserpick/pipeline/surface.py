@@ -28,6 +28,8 @@ SURFACE_BAND = 0.015
 STANDING_FRACTION = 0.6
 #: Fewest points that count as seeing something there: a top, or the bare surface.
 SEEN_POINTS = 10
+#: Fewer points than this above a surface are stray ones: it is bare.
+STRAY_POINTS = 3
 
 
 def voi_mask(points: np.ndarray, center: np.ndarray, settings: PerceptionSettings) -> np.ndarray:
@@ -210,11 +212,13 @@ def still_standing(points: np.ndarray, standing: np.ndarray, surface_z: float) -
 
     points: the cloud now (m, `base`), the arm's own points left out; standing: the object
     as it was let go (its carried shape, m, `base`); surface_z: the height (m) of the
-    surface it was set on. True when SEEN_POINTS or more rise within its footprint (its
-    level extent, FOOTPRINT_PAD wider) to STANDING_FRACTION of its height above the surface.
-    False when the cameras see the surface bare there instead: SEEN_POINTS or more of it
-    within the footprint and nothing that high (it fell over, or the hand took it along).
-    None when they see neither (something stands in their way): nothing is known.
+    surface it was set on. Within its footprint (its level extent, FOOTPRINT_PAD wider):
+    True when SEEN_POINTS or more rise to STANDING_FRACTION of its height above the
+    surface; False when the cameras see the surface bare there, SEEN_POINTS or more of it
+    and nothing above it (the object is gone: it fell off the spot, or the hand took it
+    along); None otherwise, nothing known. Something lower than expected but still there
+    is None, not False: a banana that had turned 40 degrees in the pads was let go tilted,
+    settled flat within 3 cm of its mark, and read as fallen.
     """
     height = float(standing[:, 2].max()) - surface_z
     if len(points) == 0 or height <= SURFACE_BAND:
@@ -223,6 +227,7 @@ def still_standing(points: np.ndarray, standing: np.ndarray, surface_z: float) -
     above = points[np.isfinite(d), 2] - surface_z
     if np.count_nonzero(above >= STANDING_FRACTION * height) >= SEEN_POINTS:
         return True
-    if np.count_nonzero(np.abs(above) < SURFACE_BAND) >= SEEN_POINTS:
+    on_it = np.count_nonzero(above >= SURFACE_BAND)
+    if on_it < STRAY_POINTS and np.count_nonzero(np.abs(above) < SURFACE_BAND) >= SEEN_POINTS:
         return False
     return None

@@ -75,8 +75,8 @@ Source = Literal["console", "rest", "switch", "joystick", "bench", "system"]
 ESTOP_REASON = "Stopped by the e-stop; the arm stays where it is."
 #: What the user hears when a place's post-condition fails (`_fell`).
 PLACED_NOT_STANDING = (
-    "I set the object down, but it is not standing where I let go of it: it may have fallen"
-    " over. Mark it again to pick it up."
+    "I set the object down, but I no longer see it where I let go of it: it may have fallen"
+    " off the spot. Mark it again to pick it up."
 )
 #: The watchdog's period (s), and the gap between its ticks that means the process stalled.
 WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
@@ -972,8 +972,9 @@ class Session:
 
     def _fell(self, capture: _Capture, placed: Outcome) -> bool:
         """Whether the cameras see the surface bare where the place let the object go: it
-        fell over, or the opened hand took it along (a pill bottle that clung to a pad rose
-        4.6 cm with it and fell on its side). Nothing is said where they cannot tell."""
+        fell off the spot, or the opened hand took it along (a pill bottle that clung to a
+        pad rose 4.6 cm with it and fell on its side 10 cm away). Nothing is said where they
+        cannot tell."""
         if placed.standing is None or placed.spot is None:
             return False
         points = capture.cloud.points
