@@ -215,10 +215,10 @@ def still_standing(points: np.ndarray, standing: np.ndarray, surface_z: float) -
     surface it was set on. Within its footprint (its level extent, FOOTPRINT_PAD wider):
     True when SEEN_POINTS or more rise to STANDING_FRACTION of its height above the
     surface; False when the cameras see the surface bare there, SEEN_POINTS or more of it
-    and nothing above it (the object is gone: it fell off the spot, or the hand took it
-    along); None otherwise, nothing known. Something lower than expected but still there
-    is None, not False: a banana that had turned 40 degrees in the pads was let go tilted,
-    settled flat within 3 cm of its mark, and read as fallen.
+    and fewer than STRAY_POINTS above it (the object is gone: it fell off the spot, or the
+    hand took it along); None otherwise, nothing known. Something lower than expected but
+    still there is None, not False: a banana that had turned 40 degrees in the pads was let
+    go tilted, settled flat within 3 cm of its mark, and read as fallen.
     """
     height = float(standing[:, 2].max()) - surface_z
     if len(points) == 0 or height <= SURFACE_BAND:
