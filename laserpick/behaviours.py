@@ -36,7 +36,7 @@ from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose
-from laserpick.pipeline.surface import place_target
+from laserpick.pipeline.surface import SURFACE_BAND, place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
@@ -90,11 +90,6 @@ SUPPORT_SCATTER = 0.01
 #: hand, and at one turn it comes within the margin of the upper arm where at another it
 #: hangs clear (a banana held 8 cm off its middle could be neither tucked in nor raised).
 HOLD_TURNS = (0.0, np.pi, np.pi / 2, -np.pi / 2)
-#: Points within this height (m) of a place's surface are the surface: the arm going down to
-#: set an object on it must not reach into it, but may come nearer than the clearance
-#: margin. A spice jar held from the side 3.8 cm above its support goes down with the
-#: wrist's spheres 2 mm over the table, as they were over the shelf it was picked from.
-PLACE_SURFACE_BAND = 0.015
 #: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
 PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
 #: How far (rad) the arm may be from a trajectory's start when it is sent, and how long (s)
@@ -801,7 +796,7 @@ class Behaviours:
             return Outcome(failure, held.grasp, spot=spot)
         # First around a wall under the surface's seen front (`surface_front`: a counter's
         # front runs out of the cameras' view before its top does), then without it.
-        front = surface_front(seen, float(spot[2]), PLACE_SURFACE_BAND)
+        front = surface_front(seen, float(spot[2]), SURFACE_BAND)
         front = front[obstacle_mask(front, voxel=0.0)]
         walled = CollisionChecker(
             np.vstack([around.points, front]), margin=s.clearance, filtered=True
@@ -866,10 +861,13 @@ class Behaviours:
         what it holds, which go down onto the surface) must keep clear of `checker` on the
         way down to the rest: unchecked, the wrist came down 3 mm over a mug set down
         earlier beside the spot, and after the release the hand found no way out. The
-        surface itself (PLACE_SURFACE_BAND) it must only not reach into."""
+        surface itself (its points within `surface.SURFACE_BAND` of its height) it must only
+        not reach into, and may come nearer than the margin: a spice jar held from the side
+        3.8 cm above its support goes down with the wrist's spheres 2 mm over the table, as
+        they were over the shelf it was picked from."""
         s = self.settings.motion
         reached = crowded = False
-        surface = np.abs(checker.points[:, 2] - spot[2]) < PLACE_SURFACE_BAND
+        surface = np.abs(checker.points[:, 2] - spot[2]) < SURFACE_BAND
         around, support = checker.without(surface), checker.without(~surface)
         # The middle of the held object, from the hand (m, `base` axes at the grasp).
         pts = held.points_tcp @ held.grasp.pose[:3, :3].T

@@ -961,14 +961,13 @@ class Session:
         with self._lock:
             self.task = _Task()
             self._projection = None
-            if out.ok and not fell:
-                self._set(TaskState.IDLE, f"{message} Ready.")
-            elif out.ok:
-                self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
-            else:  # the arm not home is said first; a fall, where seen, with it
-                assert out.failure is not None
-                said = f"{out.failure.message} {PLACED_NOT_STANDING}" if fell else None
+            if out.failure is not None:  # the arm not home is said first; a fall with it
+                said = f"{out.failure.message} {PLACED_NOT_STANDING}" if fell else ""
                 self._fail(Failure(out.failure.kind, said or out.failure.message), TaskState.IDLE)
+            elif fell:
+                self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
+            else:
+                self._set(TaskState.IDLE, f"{message} Ready.")
 
     def _fell(self, capture: _Capture, placed: Outcome) -> bool:
         """Whether the cameras see the surface bare where the place let the object go: it
