@@ -12,6 +12,7 @@ import sys
 import time
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 from PIL import Image
@@ -48,6 +49,7 @@ from laserpick.bench.protocols import (
     room_for,
     round_about_z,
     scan_points,
+    set_down_error,
 )
 from laserpick.bench.report import markdown
 from laserpick.bench.results import outcomes, summarize
@@ -545,6 +547,36 @@ def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) 
             assert found is not None
             gap = np.linalg.norm(cup - found[1][:2], axis=1).min()
             assert gap > reach + 0.05, f"the toy would stand {gap - reach:.3f} m from the cup"
+
+
+def test_a_set_down_object_is_judged_where_its_middle_rests(tmp_path: Path) -> None:
+    """A place turned about the vertical turns the object about its middle. A plush toy lying
+    on its side, turned 30 degrees so, rests where it was set down: its origin (the middle of
+    its seat, at one end of it lying) moved 3 cm or more, and was counted off the mark."""
+    scene = tmp_path / "toy.yaml"
+    scene.write_text(
+        "name: toy\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: f, kind: floor, xy: [1.5, 0.0], size: [1.0, 1.0]}\n"
+        "objects:\n  - {name: toy, model: stuffed_toy, on: f, xy: [1.5, 0.0], lying: true}\n"
+    )
+    with _operated(load_scene(str(scene)), 0, 1, Options()) as op:
+        ref = op.referee
+        centre, origin = ref.centre_of_mass("toy"), ref.position("toy")
+        assert set_down_error(ref, "toy", centre, np.zeros(2)) < 1e-9
+        middle = ref.to_world(centre)
+        turn = rotz(math.radians(30.0))
+
+        def turn_about_middle(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+            adr = m.joint("obj/toy").qposadr[0]
+            pos, quat = d.qpos[adr : adr + 3].copy(), d.qpos[adr + 3 : adr + 7].copy()
+            d.qpos[adr : adr + 3] = middle + turn @ (pos - middle)
+            d.qpos[adr + 3 : adr + 7] = quat_from_matrix(turn @ matrix_from_quat(quat))
+
+        op.robot.sim.call(turn_about_middle)
+        op.robot.sleep(0.5)
+        moved = float(np.linalg.norm((ref.position("toy") - origin)[:2]))
+        assert moved > 0.03, f"its origin moved only {moved * 100:.1f} cm"
+        assert set_down_error(ref, "toy", centre, np.zeros(2)) < 0.005
 
 
 def test_the_user_watches_the_dot_of_a_place_mark_on_a_top_just_below_the_pointer(

@@ -43,6 +43,7 @@ from laserpick.bench.operator import (
     PARK_SPOT_DEPTH,
     Footprint,
     Outline,
+    Referee,
     drive_to,
     follow,
     obstacles,
@@ -94,7 +95,8 @@ FLOOR_TURNS = tuple(math.radians(a) for a in sorted(range(-165, 195, 15), key=ab
 #: clear way in only 10-20 cm to a side.
 FLOOR_ACROSS = (0.0, 0.1, -0.1, 0.2, -0.2)
 #: A placed object counts as upright when its up axis is tilted under this (rad) from how it
-#: stood before, and as on target within this distance (m) of the mark plus its offset.
+#: stood before, and as on target within this distance (m) of the mark plus its offset
+#: (`set_down_error`).
 UPRIGHT_TILT = math.radians(15.0)
 PLACE_TOLERANCE = 0.03
 #: m the user leaves between the footprint of what they set down and anything else on the
@@ -567,6 +569,13 @@ def placed_tilt(model: ObjectModel, before: np.ndarray, after: np.ndarray) -> fl
     return math.acos(float(np.clip(up_before @ up_after, -1.0, 1.0)))
 
 
+def set_down_error(referee: Referee, instance: str, hit: np.ndarray, offset: np.ndarray) -> float:
+    """How far (m, level) `instance` rests from where its place mark puts it: the laser's dot
+    `hit` (m, `base`) plus `offset`, its centre of mass's offset from the hand as held (m,
+    `base` xy, the grasp's orientation)."""
+    return float(np.linalg.norm(referee.centre_of_mass(instance)[:2] - hit[:2] - offset))
+
+
 def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float = 0.0) -> Attempt:
     """One 004 section 8.3 attempt: pick `rec.instance`, parked `back` m farther back than at
     first, and set it down on another surface."""
@@ -580,10 +589,14 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         return rec
     if session.state != TaskState.AWAITING_PLACE:
         return rec.fail("execute", f"the session is {session.state.value}, not awaiting a mark")
-    # Where the object sits relative to the TCP when it is set down (m, `base` xy): the hand
-    # holds it tucked in now, and the place turns the hand back to the grasp's orientation.
+    # Where the object's centre of mass sits relative to the TCP when it is set down (m,
+    # `base` xy): the hand holds it tucked in now, and the place turns the hand back to the
+    # grasp's orientation. Its centre, not its origin: the origin is the middle of its bottom
+    # face, which lies at one end of an object on its side, and a place turned about the
+    # vertical turns the object about its middle (`behaviours.turned_hand_xy`). Seed 200's
+    # plush toy lying on its side, set down turned 30 degrees, had its origin 4.6 cm off.
     T_tcp = tcp_pose(op.robot.joint_state().q)
-    in_hand = T_tcp[:3, :3].T @ (referee.position(rec.instance) - T_tcp[:3, 3])
+    in_hand = T_tcp[:3, :3].T @ (referee.centre_of_mass(rec.instance) - T_tcp[:3, 3])
     held = session.behaviours.held
     assert held is not None  # awaiting a place mark: the session holds it
     offset = (held.grasp.pose[:3, :3] @ in_hand)[:2]
@@ -619,7 +632,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
         return rec.fail(failure.kind, failure.message)
     op.robot.sleep(0.5)
-    error = float(np.linalg.norm(referee.position(rec.instance)[:2] - placed.hit[:2] - offset))
+    error = set_down_error(referee, rec.instance, placed.hit, offset)
     model = scene.placement(rec.instance).model
     tilt = placed_tilt(model, quat_before, referee.world_quat(rec.instance))
     rec.surface = f"{here} -> {dest.name}"
