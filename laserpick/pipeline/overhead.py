@@ -67,7 +67,7 @@ def overhead_grasp(
     """
     s = settings or get_settings().grasp
     if len(target) < 3:
-        return Failure("detect_grasp", "the target has too few points for an overhead grasp")
+        return Failure("detect_grasp", "I see too little of the object for an overhead grasp.")
     centroid, _, minor = occupancy_pca(target)
     top = float(target[:, 2].max())
     across = _extent(target[:, :2], minor)

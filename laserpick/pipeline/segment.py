@@ -29,8 +29,13 @@ from laserpick.pipeline.surface import surface_height, voi_mask
 from laserpick.pipeline.types import Failure, FusedCloud, Segmentation, SupportSurface
 from laserpick.settings import PerceptionSettings
 
-NO_OBJECT = "there is no object at the mark"
-NOTHING_SEEN = "the mark is not on anything the sensors can see"
+#: What the user hears. Nothing standing at a mark on a surface is also what a clear glass or
+#: plastic object looks like to depth cameras (the beam and their light pass through it).
+NO_OBJECT = (
+    "I see no object at the mark, only the surface: a clear glass or plastic object does not"
+    " show to my cameras."
+)
+NOTHING_SEEN = "The mark is not on anything my cameras can see."
 
 #: 26-connectivity in a 3D grid (000 4.2.2).
 _TWENTY_SIX = np.ones((3, 3, 3), bool)
