@@ -549,21 +549,27 @@ def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) 
             assert gap > reach + 0.05, f"the toy would stand {gap - reach:.3f} m from the cup"
 
 
-def test_a_set_down_object_is_judged_where_its_middle_rests(tmp_path: Path) -> None:
-    """A place turned about the vertical turns the object about its middle. A plush toy lying
-    on its side, turned 30 degrees so, rests where it was set down: its origin (the middle of
-    its seat, at one end of it lying) moved 3 cm or more, and was counted off the mark."""
+def test_a_set_down_object_is_judged_by_where_it_stands(tmp_path: Path) -> None:
+    """The bench judges a place by the middle of the object's footprint. A place turned about
+    the vertical turns the object about its middle: a plush toy lying on its side, turned 30
+    degrees so, rests where it was set down, though its origin (the middle of its seat, at
+    one end of it lying) moved 3 cm or more and was counted off the mark. A can standing
+    upright is judged by its origin, as before."""
     scene = tmp_path / "toy.yaml"
     scene.write_text(
         "name: toy\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
         "surfaces:\n  - {name: f, kind: floor, xy: [1.5, 0.0], size: [1.0, 1.0]}\n"
-        "objects:\n  - {name: toy, model: stuffed_toy, on: f, xy: [1.5, 0.0], lying: true}\n"
+        "objects:\n  - {name: toy, model: stuffed_toy, on: f, xy: [1.5, 0.2], lying: true}\n"
+        "  - {name: can, model: soda_can, on: f, xy: [1.5, -0.2]}\n"
     )
     with _operated(load_scene(str(scene)), 0, 1, Options()) as op:
         ref = op.referee
-        centre, origin = ref.centre_of_mass("toy"), ref.position("toy")
-        assert set_down_error(ref, "toy", centre, np.zeros(2)) < 1e-9
-        middle = ref.to_world(centre)
+        assert np.allclose(ref.footprint_middle("can"), 0.0, atol=1e-3)
+        anchor = ref.footprint_middle("toy")
+        assert np.linalg.norm(anchor) > 0.04, "lying, its origin is at one end"
+        stands, origin = ref.body_point("toy", anchor), ref.position("toy")
+        assert set_down_error(ref, "toy", anchor, stands, np.zeros(2)) < 1e-9
+        middle = ref.to_world(stands)
         turn = rotz(math.radians(30.0))
 
         def turn_about_middle(m: mujoco.MjModel, d: mujoco.MjData) -> None:
@@ -576,7 +582,7 @@ def test_a_set_down_object_is_judged_where_its_middle_rests(tmp_path: Path) -> N
         op.robot.sleep(0.5)
         moved = float(np.linalg.norm((ref.position("toy") - origin)[:2]))
         assert moved > 0.03, f"its origin moved only {moved * 100:.1f} cm"
-        assert set_down_error(ref, "toy", centre, np.zeros(2)) < 0.005
+        assert set_down_error(ref, "toy", anchor, stands, np.zeros(2)) < 0.005
 
 
 def test_the_user_watches_the_dot_of_a_place_mark_on_a_top_just_below_the_pointer(

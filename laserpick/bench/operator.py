@@ -23,7 +23,7 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.robot.scenes import Surface, scene_config
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.transforms import invert, planar_pose
+from laserpick.transforms import invert, matrix_from_quat, planar_pose
 
 #: Hand tremor: the aim's angular noise, standard deviation (rad). About 5 mm at 1 m, a
 #: steady hand resting on the scooter's armrest. Ours; 004 does not measure it.
@@ -86,6 +86,23 @@ class Referee:
         """The object's centre of mass in `base` (m) now."""
         body = self.robot.sim.info.object_bodies[instance]
         return self.to_base(self._posed().xipos[body])
+
+    def footprint_middle(self, instance: str) -> np.ndarray:
+        """Where the object stands, as it rests now: the middle of its footprint (the level
+        middle of its bounds, `object_points`) at its lowest point, as a point fixed in the
+        object (m, its own frame), for `body_point` to follow. Upright and round, that is
+        its origin; lying on its side, the middle of its length, where its origin (the
+        middle of its bottom face) is at one end."""
+        world = self.object_points(instance, frame="world")
+        lo, hi = world.min(axis=0), world.max(axis=0)
+        middle = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
+        R = matrix_from_quat(self.world_quat(instance))
+        return R.T @ (middle - self.world_position(instance))
+
+    def body_point(self, instance: str, local: np.ndarray) -> np.ndarray:
+        """A point fixed in the object (`local`, m, its own frame) in `base` (m) now."""
+        R = matrix_from_quat(self.world_quat(instance))
+        return self.to_base(self.world_position(instance) + R @ local)
 
     def world_quat(self, instance: str) -> np.ndarray:
         """The object's orientation in `world` (w, x, y, z)."""

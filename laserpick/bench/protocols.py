@@ -569,11 +569,14 @@ def placed_tilt(model: ObjectModel, before: np.ndarray, after: np.ndarray) -> fl
     return math.acos(float(np.clip(up_before @ up_after, -1.0, 1.0)))
 
 
-def set_down_error(referee: Referee, instance: str, hit: np.ndarray, offset: np.ndarray) -> float:
-    """How far (m, level) `instance` rests from where its place mark puts it: the laser's dot
-    `hit` (m, `base`) plus `offset`, its centre of mass's offset from the hand as held (m,
-    `base` xy, the grasp's orientation)."""
-    return float(np.linalg.norm(referee.centre_of_mass(instance)[:2] - hit[:2] - offset))
+def set_down_error(
+    referee: Referee, instance: str, anchor: np.ndarray, hit: np.ndarray, offset: np.ndarray
+) -> float:
+    """How far (m, level) `instance` rests from where its place mark puts it: its footprint's
+    middle as it stood before the pick (`anchor`, `Referee.footprint_middle`, m, its own
+    frame) from the laser's dot `hit` (m, `base`) plus `offset`, that point's offset from
+    the hand as held (m, `base` xy, the grasp's orientation)."""
+    return float(np.linalg.norm(referee.body_point(instance, anchor)[:2] - hit[:2] - offset))
 
 
 def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float = 0.0) -> Attempt:
@@ -584,19 +587,22 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         return rec.fail("precondition", NO_PARKING)
     session.set_mode(op.actor, mode="pick_and_place")
     quat_before = referee.world_quat(rec.instance)
+    anchor = referee.footprint_middle(rec.instance)
     room = room_for(op, rec.instance)
     if not op.pick(rec) or rec.failure is not None:
         return rec
     if session.state != TaskState.AWAITING_PLACE:
         return rec.fail("execute", f"the session is {session.state.value}, not awaiting a mark")
-    # Where the object's centre of mass sits relative to the TCP when it is set down (m,
-    # `base` xy): the hand holds it tucked in now, and the place turns the hand back to the
-    # grasp's orientation. Its centre, not its origin: the origin is the middle of its bottom
-    # face, which lies at one end of an object on its side, and a place turned about the
-    # vertical turns the object about its middle (`behaviours.turned_hand_xy`). Seed 200's
-    # plush toy lying on its side, set down turned 30 degrees, had its origin 4.6 cm off.
+    # Where the middle of the object's footprint sits relative to the TCP when it is set down
+    # (m, `base` xy): the hand holds it tucked in now, and the place turns the hand back to
+    # the grasp's orientation. Not its origin, the middle of its bottom face, which lies at
+    # one end of an object on its side: a place turned about the vertical turns the object
+    # about its middle (`behaviours.turned_hand_xy`), and seed 200's plush toy lying on its
+    # side, set down turned 30 degrees, had its origin 4.6 cm off. Nor its centre of mass,
+    # high in a tall box: a cereal box that had turned 10 degrees in the pads and righted
+    # itself on the counter had its centre 3.6 cm off, its footprint within 3 cm.
     T_tcp = tcp_pose(op.robot.joint_state().q)
-    in_hand = T_tcp[:3, :3].T @ (referee.centre_of_mass(rec.instance) - T_tcp[:3, 3])
+    in_hand = T_tcp[:3, :3].T @ (referee.body_point(rec.instance, anchor) - T_tcp[:3, 3])
     held = session.behaviours.held
     assert held is not None  # awaiting a place mark: the session holds it
     offset = (held.grasp.pose[:3, :3] @ in_hand)[:2]
@@ -632,7 +638,7 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
         return rec.fail(failure.kind, failure.message)
     op.robot.sleep(0.5)
-    error = set_down_error(referee, rec.instance, placed.hit, offset)
+    error = set_down_error(referee, rec.instance, anchor, placed.hit, offset)
     model = scene.placement(rec.instance).model
     tilt = placed_tilt(model, quat_before, referee.world_quat(rec.instance))
     rec.surface = f"{here} -> {dest.name}"
