@@ -864,9 +864,14 @@ class Behaviours:
         surface itself (its points within `surface.SURFACE_BAND` of its height) it must only
         not reach into, and may come nearer than the margin: a spice jar held from the side
         3.8 cm above its support goes down with the wrist's spheres 2 mm over the table, as
-        they were over the shelf it was picked from."""
+        they were over the shelf it was picked from. So with the floor, for a spot on it."""
         s = self.settings.motion
         reached = crowded = False
+        if spot[2] < SURFACE_BAND:
+            # On the floor, the floor is the support: held level from the side 8 cm above
+            # it, a pill bottle would go down with the wrist's spheres 8 mm over the floor,
+            # as over a table top, and was refused three times for the floor's 2 cm margin.
+            checker = checker.floor_as_support()
         surface = np.abs(checker.points[:, 2] - spot[2]) < SURFACE_BAND
         around, support = checker.without(surface), checker.without(~surface)
         # The middle of the held object, from the hand (m, `base` axes at the grasp).

@@ -338,6 +338,8 @@ class CollisionChecker:
         self.points = pts
         self.tree = cKDTree(self.points) if len(self.points) else None
         self.margin = margin
+        #: m the arm keeps above the floor (z = 0 in `base`): see `floor_as_support`
+        self.floor_clearance = FLOOR_CLEARANCE
         self.frames = tuple(frames)
         # Where the arm stood counts as seen; only the seen-space test, with frames, asks.
         stood = q_self is not None and bool(self.frames)
@@ -443,6 +445,14 @@ class CollisionChecker:
         out.tree = cKDTree(out.points) if len(out.points) else None
         return out
 
+    def floor_as_support(self) -> CollisionChecker:
+        """This checker with the floor as a support the arm may come to but not into (no
+        FLOOR_CLEARANCE above it): for an arm setting something down on the floor, as it
+        may come to a table top it sets something down on."""
+        out = copy.copy(self)
+        out.floor_clearance = 0.0
+        return out
+
     def unseen(self, centres: np.ndarray, radius: np.ndarray) -> np.ndarray:
         """(N,) whether each sphere (centres (N, 3), `base`, m; radius (N,) m) reaches into
         space no camera saw, tested at its centre and the six points of its surface along
@@ -473,7 +483,8 @@ class CollisionChecker:
         reach = radius[None, :] + margin
         # A negative margin (the hand at its grasp may touch the support) holds for the
         # floor too: for an object on the floor, the floor is the support.
-        floor = centres[..., 2] < radius + (FLOOR_CLEARANCE if margin >= 0 else margin)
+        clearance = self.floor_clearance if margin >= 0 else margin
+        floor = centres[..., 2] < radius + clearance
         boxes = (_box_gaps(centres) < reach[..., None]) & _CHECKED[body]
         cloud = np.zeros((B, S), bool)
         if self.tree is not None:
