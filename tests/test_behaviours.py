@@ -930,49 +930,31 @@ def test_an_object_held_by_one_end_is_tucked_in_with_the_hand_turned_away_from_t
     assert free.clearance_ok(q, payload=rod)[0]
 
 
-def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_into_it(robot):
+@pytest.mark.parametrize("top", [0.73, 0.0], ids=["table", "floor"])
+def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_into_it(
+    robot, top: float
+):
     """A short jar held level from the side, 5 cm above its support: set down, the wrist's
     spheres come within the 1 cm margin of the table top, as they did at the pick, and the
     place goes ahead (it was refused: "the arm would come down too close"). 1 cm lower, they
-    would reach into the top, and it is still refused."""
+    would reach into the top, and it is still refused. The floor is such a support too: a
+    pill bottle held so was refused three times for the floor's 2 cm margin."""
     b = Behaviours(robot)
-    top = 0.73
     xs, ys = np.meshgrid(np.arange(1.3, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
-    table = CollisionChecker(np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, top)])
+    table = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, top)]
+    support = CollisionChecker(table if top > 0 else np.zeros((0, 3)))
     ring = np.linspace(0, 2 * np.pi, 12, endpoint=False)
     jar = np.c_[0.02 * np.cos(ring), 0.02 * np.sin(ring), 0 * ring]
     spot = np.array([1.62, -0.30, top])
     for h, ok in ((0.05, True), (0.04, False)):
         side = _side_pose(1.60, -0.30, top + h)
         q_side = ik_tcp(side, dims.UR5_READY_Q)[0]
-        held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, table)
-        found = b._place_poses(held, spot, q_side, table)
+        held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, support)
+        found = b._place_poses(held, spot, q_side, support)
         assert isinstance(found, Failure) != ok, (h, found)
         if ok:
             _, down, _ = found
-            rest = [q for q in down if tcp_pose(q)[2, 3] >= top + h - 1e-3]
-            assert not table.clearance_ok(np.array(rest), hand=False).all()  # within 1 cm
-            assert table.clearance_ok(np.array(rest), hand=False, margin=0.0).all()
-
-
-def test_the_arm_may_come_down_near_the_floor_it_sets_an_object_on_but_not_into_it(robot):
-    """The floor is a support like a table top: a jar held level from the side 5 cm above it
-    goes down with the wrist's spheres 2 mm over the floor (a pill bottle held so was
-    refused three times for the floor's 2 cm margin). 1 cm lower they would reach into the
-    floor, and it is refused."""
-    b = Behaviours(robot)
-    ring = np.linspace(0, 2 * np.pi, 12, endpoint=False)
-    jar = np.c_[0.02 * np.cos(ring), 0.02 * np.sin(ring), 0 * ring]
-    nothing = CollisionChecker(np.zeros((0, 3)))
-    spot = np.array([1.62, -0.30, 0.0])
-    for h, ok in ((0.05, True), (0.04, False)):
-        side = _side_pose(1.60, -0.30, h)
-        q_side = ik_tcp(side, dims.UR5_READY_Q)[0]
-        held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, nothing)
-        found = b._place_poses(held, spot, q_side, nothing)
-        assert isinstance(found, Failure) != ok, (h, found)
-        if ok:
-            _, down, _ = found
-            rest = np.array([q for q in down if tcp_pose(q)[2, 3] >= h - 1e-3])
-            assert not nothing.clearance_ok(rest, hand=False).all()  # within the floor's 2 cm
-            assert nothing.floor_as_support().clearance_ok(rest, hand=False).all()
+            rest = np.array([q for q in down if tcp_pose(q)[2, 3] >= top + h - 1e-3])
+            assert not support.clearance_ok(rest, hand=False).all()  # within the margin
+            near = support.floor_as_support()
+            assert near.clearance_ok(rest, hand=False, margin=0.0).all()
