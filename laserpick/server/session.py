@@ -962,8 +962,8 @@ class Session:
             self.task = _Task()
             self._projection = None
             if out.failure is not None:  # the arm not home is said first; a fall with it
-                said = f"{out.failure.message} {PLACED_NOT_STANDING}" if fell else ""
-                self._fail(Failure(out.failure.kind, said or out.failure.message), TaskState.IDLE)
+                said = out.failure.message + (f" {PLACED_NOT_STANDING}" if fell else "")
+                self._fail(Failure(out.failure.kind, said), TaskState.IDLE)
             elif fell:
                 self._fail(Failure("execute", PLACED_NOT_STANDING), TaskState.IDLE)
             else:
