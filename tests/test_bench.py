@@ -32,7 +32,7 @@ from laserpick.bench.operator import (
     parking_pose,
     plan_drive,
 )
-from laserpick.bench.picking import BENCH, LEVER_MAX, lever
+from laserpick.bench.picking import BENCH, LEVER_MAX, ScriptedOperator, lever, open_session
 from laserpick.bench.protocols import (
     FLOOR_TURNS,
     JEEVES_MODELS,
@@ -429,6 +429,35 @@ def test_the_helper_empties_the_basket_of_any_object_after_an_attempt() -> None:
         op.tidy()
         assert not op.referee.in_basket(name)
         assert np.linalg.norm(op.referee.position(name)[:2]) > 3.0  # out of the scene
+
+
+def test_a_tasks_random_draws_do_not_depend_on_the_tasks_before_it() -> None:
+    """The user's, the grasp sampler's and the cameras' draws of a pick-place task come from
+    (the trial's seed, the task) alone: after other draws, task 2 begins as it began before;
+    task 3 draws otherwise."""
+    session = open_session(load_scene("isolation", seed=1), seed=5)
+    try:
+        op = ScriptedOperator(session, np.random.default_rng(5), seed=5)
+        sampler, robot = session.behaviours.rng, session.robot
+
+        def draws() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            depth = robot.capture()[0].depth
+            return op.rng.random(4), sampler.random(4), depth
+
+        op.begin_task(2)
+        first = draws()
+        later = draws()  # what the task's attempts go on to draw
+        assert not np.array_equal(first[2], later[2]), "the cameras draw noise"
+        op.begin_task(2)
+        again = draws()
+        for a, b in zip(first, again, strict=True):
+            np.testing.assert_array_equal(a, b)
+        op.begin_task(3)
+        other = draws()
+        for a, b in zip(first, other, strict=True):
+            assert not np.array_equal(a, b)
+    finally:
+        session.close()
 
 
 def test_retries_at_one_object_count_as_one_task() -> None:

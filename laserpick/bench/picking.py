@@ -115,7 +115,8 @@ def open_session(scene: Scene, seed: int, settle: float = 0.5) -> Session:
 class ScriptedOperator:
     """The user and the experimenter of one trial, on one session.
 
-    rng: the operator's own draws (tremor, choices), seeded per trial.
+    rng: the operator's own draws (tremor, choices), seeded per trial (and per task, where
+        a protocol calls `begin_task`).
     tremor: the aim's angular noise, standard deviation (rad).
     """
 
@@ -189,6 +190,17 @@ class ScriptedOperator:
     def base_pose(self) -> np.ndarray:
         """Where the scooter stands, (x, y, yaw) in `world`: the user sees it."""
         return self.robot.base_pose()
+
+    def begin_task(self, task: int) -> None:
+        """Seed the user's, the session's and the cameras' draws for task `task` of the trial
+        from (the trial's seed, `task`) alone. Without it, whatever an earlier task did (where
+        an object ended up, how many grasps were sampled) shifts every later draw, and a change
+        that mends one task sends the rest of its trial other ways. The world the task finds
+        still depends on the tasks before it."""
+        user, session, sensors = np.random.SeedSequence([self.seed, task]).spawn(3)
+        self.rng = np.random.default_rng(user)
+        self.session.reseed(session)
+        self.robot.reseed_sensors(sensors)
 
     # --- one attempt ------------------------------------------------------------------------
 

@@ -523,6 +523,7 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     out = []
     with _operated(scene, trial, seed, opt) as op:
         for task, name in enumerate(_limit(_shuffled(op, _instances(scene)), opt)):
+            op.begin_task(task)
             back = 0.0
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)

@@ -364,6 +364,11 @@ class DepthCameras:
         valid = (z >= dims.DEPTH_MIN) & (z <= dims.DEPTH_MAX) & ~drop
         return z * valid  # multiplying by the mask is 10x faster than np.where here
 
+    def reseed(self, seed: int | np.random.SeedSequence) -> None:
+        """Draw the noise from here on as freshly built cameras seeded with `seed` would."""
+        self._rng = np.random.default_rng(seed)
+        self._pool = None
+
     def _normal(self, shape: tuple[int, int]) -> np.ndarray:
         """Standard normal float32 noise of `shape`: a slice at a random offset of a pool drawn
         once. Drawing 300k normals costs ~5 ms, twice per camera; the slice costs nothing.

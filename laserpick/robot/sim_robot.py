@@ -64,6 +64,11 @@ class SimRobot:
         """Frames plus per-pixel geom ids. Ground truth: for tests and bench scoring only."""
         return self._capture_pool.submit(self._render, self.sim.snapshot(), True).result()
 
+    def reseed_sensors(self, seed: int | np.random.SeedSequence) -> None:
+        """Draw the cameras' noise from here on as from a fresh start with `seed` (the bench
+        seeds each task's draws apart from the tasks before it)."""
+        self._capture_pool.submit(lambda: self._thread_state()[0].reseed(seed)).result()
+
     def laser_hits(self, snap: Snapshot | None = None) -> list[np.ndarray]:
         """World points where the lit beams land now (simulator truth; for display and scoring)."""
         snap = snap or self.sim.snapshot()

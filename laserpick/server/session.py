@@ -283,6 +283,14 @@ class Session:
         self._watchdog.join(timeout=1.0)
         self.robot.close()
 
+    def reseed(self, seed: int | np.random.SeedSequence) -> None:
+        """Draw the planner's and the grasp sampler's random numbers from here on as a fresh
+        session seeded with `seed` would. Between jobs only: they draw from it."""
+        if self.busy:
+            raise RuntimeError("the session is busy; reseed it between jobs")
+        # In place: the behaviours hold the same generator.
+        self._rng.bit_generator.state = np.random.default_rng(seed).bit_generator.state
+
     # --- listeners --------------------------------------------------------------------------
 
     def on_event(self, fn: Callable[[dict[str, Any]], None]) -> None:
