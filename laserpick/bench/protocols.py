@@ -614,11 +614,11 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
     dests = [s for s in markable if s.name != here] or [scene.surface(here)]
     # A random other surface; where it has no free spot, or no way to park at one, the user
     # takes the next, as a person with something in hand would.
-    failure = Failure("precondition", "no surface to put it on")
+    refused = []
     for dest in (dests[int(k)] for k in op.rng.permutation(len(dests))):
         spot = free_spot(op, dest, room, rec.instance)
         if spot is None:
-            failure = Failure("precondition", f"no free spot on {dest.name}")
+            refused.append(f"no free spot on {dest.name}")
             continue
         local_y, spot_world = spot
         local_x = float(dest.to_local(spot_world[:2])[0])
@@ -626,9 +626,9 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         works_at = None if dest.kind == "floor" else dest.name
         if _park(op, scene, dest, local_x, local_y, spot_world[2], works_at, outline):
             break
-        failure = Failure("precondition", f"the user could not park at {dest.name}")
+        refused.append(f"the user could not park at {dest.name}")
     else:
-        return rec.fail(failure.kind, failure.message)
+        return rec.fail("precondition", "; ".join(refused) or "no surface to put it on")
     aims = _aims_in_sight(op, dest, spot_world, room, rec.instance)
     for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand still holds it
         placed = op.place(aim)
