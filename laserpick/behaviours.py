@@ -866,7 +866,10 @@ class Behaviours:
         3.8 cm above its support goes down with the wrist's spheres 2 mm over the table, as
         they were over the shelf it was picked from. So with the floor, for a spot on it."""
         s = self.settings.motion
-        reached = crowded = False
+        reached = False
+        #: What the arm would come too near on a way down: the floor, the surface, or other
+        #: things (a keep-out box, points of the cloud).
+        crowded: set[str] = set()
         if spot[2] < SURFACE_BAND:
             # On the floor, the floor is the support: held level from the side 8 cm above
             # it, a pill bottle would go down with the wrist's spheres 8 mm over the floor,
@@ -898,15 +901,26 @@ class Behaviours:
                 to_rest = cartesian_line(q_above, T_rest, s.cartesian_step)
                 if down is None or to_rest is None:
                     continue
-                if not (
-                    around.clearance_ok(to_rest, hand=False).all()
-                    and support.clearance_ok(to_rest, hand=False, margin=0.0).all()
-                ):
-                    crowded = True
+                near = around.clearance_ok(to_rest, hand=False)
+                into = support.clearance_ok(to_rest, hand=False, margin=0.0)
+                if not (near.all() and into.all()):
+                    k = int(np.argmin(near & into))  # the first posture that fails
+                    hits = around.what_hits(to_rest[k], hand=False) if not near[k] else []
+                    crowded.update(["floor"] if "floor" in hits else hits or ["surface"])
                     continue
                 return q_above, down, T_above
         if not reached:
             return Failure("ik_plan", "The arm cannot reach above that spot.")
+        if crowded and crowded <= {"floor", "surface"}:
+            # A place keeps the grasp's orientation: a jar held from a shelf's edge with the
+            # hand tilted up would take the wrist into the floor, mark after mark, where
+            # "too close to something" told the user nothing they could see.
+            floor = spot[2] < SURFACE_BAND or "surface" not in crowded
+            into_what = "the floor" if floor else "the surface"
+            return Failure(
+                "ik_plan",
+                f"Held as it is, the arm would reach into {into_what} to set it down there.",
+            )
         if crowded:
             return Failure("ik_plan", "The arm would come down too close to something there.")
         return Failure("ik_plan", "The arm cannot lower the object there.")

@@ -937,8 +937,9 @@ def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_int
     """A short jar held level from the side, 5 cm above its support: set down, the wrist's
     spheres come within the 1 cm margin of the table top, as they did at the pick, and the
     place goes ahead (it was refused: "the arm would come down too close"). 1 cm lower, they
-    would reach into the top, and it is still refused. The floor is such a support too: a
-    pill bottle held so was refused three times for the floor's 2 cm margin."""
+    would reach into the top, and it is still refused, with what it would reach into named.
+    The floor is such a support too: a pill bottle held so was refused three times for the
+    floor's 2 cm margin."""
     b = Behaviours(robot)
     xs, ys = np.meshgrid(np.arange(1.3, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
     table = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, top)]
@@ -952,6 +953,12 @@ def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_int
         held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, support)
         found = b._place_poses(held, spot, q_side, support)
         assert isinstance(found, Failure) != ok, (h, found)
+        if not ok:  # the refusal says what the wrist would reach into
+            assert isinstance(found, Failure)
+            into = "the floor" if top == 0.0 else "the surface"
+            assert found.message == (
+                f"Held as it is, the arm would reach into {into} to set it down there."
+            ), found.message
         if ok:
             _, down, _ = found
             rest = np.array([q for q in down if tcp_pose(q)[2, 3] >= top + h - 1e-3])
