@@ -28,7 +28,6 @@ from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     CollisionChecker,
-    carried_shape,
     obstacle_mask,
     surface_front,
 )
@@ -380,12 +379,9 @@ class Behaviours:
             )
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
-        # The surface it stood on, as perceived; its lowest seen point when the surface is
-        # unknown or above it (an object seen only from above a table's edge).
-        lowest = float(grasps.target[:, 2].min())
-        support = lowest if grasps.support is None else min(grasps.support, lowest)
-        pts = carried_shape(grasps.target, support)
-        pts_tcp = (pts - grasp.position) @ grasp.pose[:3, :3]
+        support = grasps.stands_on
+        pts = grasps.carried()
+        pts_tcp = grasp.in_hand(pts)
         around = self._without_leftovers(grasps.surroundings, pts, support)
         self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, around)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.

@@ -19,6 +19,7 @@ from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
     carried_shape,
+    held_clear_of_arm,
     self_filter,
     sphere_centres,
     surface_front,
@@ -433,6 +434,36 @@ def test_from_the_stowed_arm_the_transit_goes_out_through_the_unstow_pose():
     plan = plan_pick(home, q_grasp, blocked, blocked, rng, s, via=(ready,), unstow=unstow)
     assert not isinstance(plan, Failure), plan
     assert np.abs(plan.transit.q - unstow).max(axis=1).min() > 0.05
+
+
+def test_the_lift_keeps_what_the_hand_will_hold_off_the_forearm():
+    """Far out over the 87 cm counter, the arm straightens as it lifts and its forearm comes
+    down over the hand. A bowl 14 cm across held by its far rim would end the full lift
+    under the forearm, where no way onward can start: the lift is the low one instead. Not
+    holding it, the full lift is clear."""
+    s = get_settings().motion
+    q = np.array([-0.01, -1.27, 0.93, 1.77, 1.87, 1.66])  # a grasp from above, 1.57 m out
+    T = tcp_pose(q)
+    middle = T[:3, 3] + [-0.065, 0.0, 0.0]  # nearer the robot than the rim in the hand
+    turn = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    bowl = np.vstack(
+        [
+            np.c_[middle[0] + r * np.cos(turn), middle[1] + r * np.sin(turn), np.full(24, z)]
+            for r in (0.04, 0.07)
+            for z in T[2, 3] + np.arange(-0.04, 0.025, 0.02)
+        ]
+    )
+    payload = Grasp(T, 0.01).in_hand(bowl)
+    empty = CollisionChecker(EMPTY, margin=s.clearance)
+    full = straight_lift(q, T, empty, s)
+    assert full is not None
+    assert tcp_pose(full[-1])[2, 3] - T[2, 3] == pytest.approx(s.lift, abs=1e-6)
+    clear = held_clear_of_arm(full, payload, s.clearance)
+    assert clear[0] and not clear[-1]
+    held = straight_lift(q, T, empty, s, payload)
+    assert held is not None
+    assert tcp_pose(held[-1])[2, 3] - T[2, 3] == pytest.approx(s.lift_low, abs=1e-6)
+    assert held_clear_of_arm(held, payload, s.clearance).all()
 
 
 def test_under_a_board_the_lift_is_the_low_one_then_the_least_then_none():

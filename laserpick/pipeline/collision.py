@@ -109,6 +109,29 @@ def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarr
     return np.einsum("bsij,sj->bsi", F[..., :3, :3], model.centre) + F[..., :3, 3]
 
 
+def held_points(frames: np.ndarray, payload: np.ndarray) -> np.ndarray:
+    """Where (B, P, 3; m, `base`) the points `payload` (P, 3; m, TCP frame) of a held object
+    are with the arm at body frames (B, 7, 4, 4)."""
+    T = frames[:, 6] @ T_FLANGE_TCP
+    return np.einsum("bij,pj->bpi", T[:, :3, :3], payload) + T[:, None, :3, 3]
+
+
+def held_clear_of_arm(
+    Q: np.ndarray, payload: np.ndarray, margin: float, frames: np.ndarray | None = None
+) -> np.ndarray:
+    """(B,) whether a held object (`payload`, its points (P, 3) in the TCP frame, m) keeps
+    `margin` (m) off the arm's own upper links (up to PAYLOAD_CLEAR_OF_BODY) at each
+    configuration Q[b] (B, 6) (rad; `frames`: their body frames, if at hand). The wrist links
+    next to the hand are expected near it."""
+    frames = body_frames(np.atleast_2d(Q)) if frames is None else frames
+    held = held_points(frames, payload)
+    upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
+    links = sphere_centres(frames)[:, upper]
+    gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
+    reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
+    return ~(gap < reach).any(axis=(1, 2))
+
+
 #: The arm's reach from its shoulder, with the open hand (m): obstacles beyond cannot matter.
 REACH = 1.15
 _SHOULDER = np.array([*ARM_MOUNT_POS[:2], ARM_MOUNT_POS[2] + UR5_D[0]])
@@ -399,15 +422,8 @@ class CollisionChecker:
             centres, radius, body = centres[:, keep], radius[keep], body[keep]
         clear = np.ones(len(Q), bool)
         if payload is not None and len(payload):
-            T = frames[:, 6] @ T_FLANGE_TCP
-            held = np.einsum("bij,pj->bpi", T[:, :3, :3], payload) + T[:, None, :3, 3]
-            # The held object must also keep off the arm's own upper links: the wrist links
-            # next to the hand are expected near it.
-            upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
-            links = sphere_centres(frames)[:, upper]
-            gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
-            reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
-            clear &= ~(gap < reach).any(axis=(1, 2))
+            held = held_points(frames, payload)
+            clear &= held_clear_of_arm(Q, payload, margin, frames)
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
             body = np.append(body, np.full(len(payload), HAND_BODY))

@@ -89,6 +89,18 @@ class GraspSet:
         g = self.clusters.grasps
         return [g[i] for members in self.clusters.clusters for i in members]
 
+    @property
+    def stands_on(self) -> float:
+        """Height (m, `base`) the target stands on, as a carry takes it: the surface it was
+        seen on, or its lowest seen point where that is lower or no surface was found (an
+        object seen only from above a table's edge)."""
+        lowest = float(self.target[:, 2].min())
+        return lowest if self.support is None else min(self.support, lowest)
+
+    def carried(self) -> np.ndarray:
+        """The points (m, `base`) that stand for the target in the hand (`carried_shape`)."""
+        return carried_shape(self.target, self.stands_on)
+
 
 def vertical_grasp(
     target: np.ndarray, support: float | None, settings: Settings
@@ -332,6 +344,7 @@ def plan_first(
     stowed = at_pose(q_now, UR5_HOME_Q)
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
     searches = Searches(s.rrt_max_failed)
+    carried = found.carried()
     tried = 0
     for grasp in found.ordered() if order is None else order:
         tried += 1
@@ -348,6 +361,7 @@ def plan_first(
             check_hand=found.strategy == "vertical",
             searches=searches,
             unstow=UR5_UNSTOW_Q if stowed else None,
+            payload=grasp.in_hand(carried),
         )
         if not isinstance(plan, Failure):
             return plan, grasp, tried

@@ -22,7 +22,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from laserpick.description import dims
 from laserpick.description.collision import GRIPPER_CAPSULES
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.timing import time_parametrize
 from laserpick.pipeline.trajectory import Trajectory
@@ -270,14 +270,25 @@ class PickPlan:
 
 
 def straight_lift(
-    q_from: np.ndarray, T_grasp: np.ndarray, surroundings: CollisionChecker, s: MotionSettings
+    q_from: np.ndarray,
+    T_grasp: np.ndarray,
+    surroundings: CollisionChecker,
+    s: MotionSettings,
+    payload: np.ndarray | None = None,
 ) -> np.ndarray | None:
     """The straight lift from q_from to `lift` above the grasp pose T_grasp, or to `lift_low`
     where the full lift is blocked (a shelf's board above), or to `lift_least` where that is
-    too: joint waypoints, or None if none is clear of the surroundings for the arm."""
+    too: joint waypoints, or None if none is clear of the surroundings for the arm.
+
+    payload: the object as it will be held (points, m, TCP frame), which must keep clear of
+    the arm's upper links all the way (`held_clear_of_arm`). Lifted from far out over the
+    87 cm counter, the arm straightens and its forearm comes down over the hand: a bowl held
+    by its far rim ended the full lift under it, and no way onward could start there."""
     for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
         lift = cartesian_line(q_from, lifted_pose(T_grasp, height), s.cartesian_step)
-        if lift is not None and surroundings.clearance_ok(lift, hand=False).all():
+        if lift is None or not surroundings.clearance_ok(lift, hand=False).all():
+            continue
+        if payload is None or held_clear_of_arm(lift, payload, surroundings.margin).all():
             return lift
     return None
 
@@ -310,6 +321,7 @@ def plan_pick(
     check_hand: bool = True,
     searches: Searches | None = None,
     unstow: np.ndarray | None = None,
+    payload: np.ndarray | None = None,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
@@ -321,6 +333,7 @@ def plan_pick(
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
     already tested the hand's exact shape there (GPD, EL-E's sweep) may skip it.
     searches: the pick's joint-space searches so far, when several grasps are tried.
+    payload: the object as the hand will hold it (points, m, TCP frame), for the lift.
 
     world: the whole cloud; surroundings: the cloud less the target. The arm is checked
     against the world all the way. The hand is checked against the world on the transit,
@@ -351,7 +364,7 @@ def plan_pick(
         return Failure("ik_plan", "The straight approach to this grasp is blocked.")
     approach[-1] = q_grasp
     up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
-    lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s)
+    lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = None

@@ -188,6 +188,10 @@ class Grasp:
     def axis(self) -> np.ndarray:
         return self.pose[:3, 0]
 
+    def in_hand(self, points: np.ndarray) -> np.ndarray:
+        """`points` (N, 3; m, `base`) in this grasp's TCP frame: where they are held."""
+        return (points - self.position) @ self.pose[:3, :3]
+
     @property
     def score(self) -> float:
         return self.scores.total if self.scores is not None else 0.0
