@@ -380,7 +380,7 @@ class Behaviours:
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
         support = grasps.stands_on
-        pts = grasps.carried()
+        pts = grasps.carried
         pts_tcp = grasp.in_hand(pts)
         around = self._without_leftovers(grasps.surroundings, pts, support)
         self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, around)
