@@ -116,15 +116,17 @@ def held_points(frames: np.ndarray, payload: np.ndarray) -> np.ndarray:
     return np.einsum("bij,pj->bpi", T[:, :3, :3], payload) + T[:, None, :3, 3]
 
 
-def held_clear_of_arm(
-    Q: np.ndarray, payload: np.ndarray, margin: float, frames: np.ndarray | None = None
-) -> np.ndarray:
+def held_clear_of_arm(Q: np.ndarray, payload: np.ndarray, margin: float) -> np.ndarray:
     """(B,) whether a held object (`payload`, its points (P, 3) in the TCP frame, m) keeps
     `margin` (m) off the arm's own upper links (up to PAYLOAD_CLEAR_OF_BODY) at each
-    configuration Q[b] (B, 6) (rad; `frames`: their body frames, if at hand). The wrist links
-    next to the hand are expected near it."""
-    frames = body_frames(np.atleast_2d(Q)) if frames is None else frames
-    held = held_points(frames, payload)
+    configuration Q[b] (B, 6) (rad). The wrist links next to the hand are expected near it."""
+    frames = body_frames(np.atleast_2d(Q))
+    return _off_upper_links(frames, held_points(frames, payload), margin)
+
+
+def _off_upper_links(frames: np.ndarray, held: np.ndarray, margin: float) -> np.ndarray:
+    """`held_clear_of_arm` for body frames (B, 7, 4, 4) and the held points where they are
+    (B, P, 3; m, `base`, `held_points`)."""
     upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
     links = sphere_centres(frames)[:, upper]
     gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
@@ -423,7 +425,7 @@ class CollisionChecker:
         clear = np.ones(len(Q), bool)
         if payload is not None and len(payload):
             held = held_points(frames, payload)
-            clear &= held_clear_of_arm(Q, payload, margin, frames)
+            clear &= _off_upper_links(frames, held, margin)
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
             body = np.append(body, np.full(len(payload), HAND_BODY))
