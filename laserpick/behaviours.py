@@ -20,7 +20,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -28,6 +27,7 @@ from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     CollisionChecker,
+    not_carried,
     obstacle_mask,
     surface_front,
 )
@@ -79,8 +79,6 @@ WITHDRAW_TURNS = tuple(np.radians([0.0, 15.0, -15.0, 30.0, -30.0]))
 #: search is random, and from a hand just drawn out of the 69 cm shelf's gap the second found
 #: the way the first had not (the session's retreat then tucked it in, the task failed).
 TUCK_SEARCHES = 2
-#: Points this close (m) to a held object's points are taken to be the object itself.
-CARRIED_PADDING = 0.03
 #: Height (m) above the surface an object stood on up to which points are the surface's own:
 #: its seen points scatter by a few millimetres (`carried_shape` fills down to this height).
 SUPPORT_SCATTER = 0.01
@@ -144,6 +142,10 @@ class Held:
     height_above_support: float
     points_tcp: np.ndarray
     surroundings: CollisionChecker
+
+    def at(self, T_tcp: np.ndarray) -> np.ndarray:
+        """The object's points (m, `base`) with the TCP at pose T_tcp (4, 4), `base`."""
+        return self.points_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
 
 
 @functools.cache
@@ -684,7 +686,7 @@ class Behaviours:
         # out of the basket, and a straight way to ready swept the fingers through it (152 N,
         # a protective stop). The object can only have fallen from where the hand let go.
         T = tcp_pose(self._q())
-        let_go = held.points_tcp @ T[:3, :3].T + T[:3, 3]
+        let_go = held.at(T)
         around = CollisionChecker(
             np.vstack([held.surroundings.points, let_go]),
             margin=self.settings.motion.clearance,
@@ -704,12 +706,17 @@ class Behaviours:
                     return back
         return back
 
-    def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
+    def place(
+        self, cloud: FusedCloud, mark: np.ndarray, blind: np.ndarray | None = None
+    ) -> Outcome:
         """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).
 
         cloud: a fresh capture's fused cloud (the held object and the arm in it are ignored);
-        mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
-        its front edge if it is too close). The object goes down with the grasp's orientation
+        mark: the place mark (m, `base`); blind: what the views of the drive saw where no
+        camera sees now (`Recalled.blind_points`, m, `base`), obstacles to the carry too.
+
+        The mark must be on a flat surface (moved back from its front edge if it is too
+        close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
         hand opens and leaves it (drawn back along its approach where that way is clear, else
@@ -726,7 +733,11 @@ class Behaviours:
         if isinstance(spot, Failure):
             return Outcome(Failure("precondition", f"I can't place there: {spot.message}."))
         q_now = self._q()
-        obstacles = cloud.points[self._not_carried(cloud.points, q_now, held)]
+        # A counter the scooter parked beside may lie in no camera's view, and the carry
+        # from the tucked pose swept the hand through it (151-166 N): what the views of the
+        # drive saw there stands in for it.
+        pts = cloud.points if blind is None or not len(blind) else np.vstack([cloud.points, blind])
+        obstacles = pts[not_carried(pts, held.at(tcp_pose(q_now)))]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
         found = self._place_poses(held, spot, q_now, checker)
         if isinstance(found, Failure):
@@ -782,7 +793,7 @@ class Behaviours:
         # the object pushed 12-20 cm away or off the counter). Where it was let go, as held,
         # and as the cameras now see it: a cereal box that had slid and turned in the pads
         # stood 3 cm from where it was held, and the wrist met it on the way home (156 N).
-        standing = held.points_tcp @ T_release[:3, :3].T + T_release[:3, 3]
+        standing = held.at(T_release)
         seen = np.vstack([checker.points, self._seen_now()])
         around = CollisionChecker(np.vstack([seen, standing]), margin=s.clearance, filtered=True)
         # A guard stop short of the surface (the wrist met the floor: 2 of 39 pick-place
@@ -936,18 +947,9 @@ class Behaviours:
         pts = surroundings.points
         if len(pts) == 0 or len(carried) == 0:
             return surroundings
-        d, _ = cKDTree(carried).query(pts, distance_upper_bound=CARRIED_PADDING)
-        return surroundings.without(np.isfinite(d) & (pts[:, 2] > support + SUPPORT_SCATTER))
-
-    @staticmethod
-    def _not_carried(points: np.ndarray, q: np.ndarray, held: Held) -> np.ndarray:
-        """Mask of the points that are not the held object, at joint angles q (6,)."""
-        T = tcp_pose(q)
-        carried = held.points_tcp @ T[:3, :3].T + T[:3, 3]
-        if len(carried) == 0:
-            return np.ones(len(points), bool)
-        d, _ = cKDTree(carried).query(points, distance_upper_bound=CARRIED_PADDING)
-        return ~np.isfinite(d)
+        return surroundings.without(
+            ~not_carried(pts, carried) & (pts[:, 2] > support + SUPPORT_SCATTER)
+        )
 
     def approach(self, perception: Perception) -> Perception | Failure:
         """Jeeves' centroid approach (003 section IV): drive the base until the perceived

@@ -145,6 +145,8 @@ PAYLOAD_POINT_RADIUS = 0.01
 #: point taken as its top.
 CARRIED_VOXEL = 0.02
 CARRIED_TOP_BAND = 0.02
+#: Points this close (m) to a held object's points are taken to be the object itself.
+CARRIED_PADDING = 0.03
 #: A held object is checked against the arm's bodies up to this one (3: wrist 1).
 PAYLOAD_CLEAR_OF_BODY = 3
 #: A joint segment's every this-many-th configuration is checked before the rest.
@@ -279,6 +281,18 @@ def self_filter(points: np.ndarray, q: np.ndarray, padding: float = 0.03) -> np.
     for c, r in zip(centres, SPHERES.radius + padding, strict=True):
         keep[tree.query_ball_point(c, r)] = False
     return keep
+
+
+def not_carried(
+    points: np.ndarray, carried: np.ndarray, padding: float = CARRIED_PADDING
+) -> np.ndarray:
+    """Mask (N,) of the points (N, 3) that are not the held object, whose points (M, 3) are
+    `carried` (m, one frame for both): none of them within `padding` (m). The cameras see
+    what the hand holds, and it must not be taken for an obstacle to its own carry."""
+    if len(carried) == 0 or len(points) == 0:
+        return np.ones(len(points), bool)
+    d, _ = cKDTree(np.asarray(carried, float)).query(points, distance_upper_bound=padding)
+    return ~np.isfinite(d)
 
 
 def within_reach(points: np.ndarray) -> np.ndarray:

@@ -45,6 +45,7 @@ import numpy as np
 
 from laserpick.behaviours import GRIPPER_TIME, Behaviours, Outcome
 from laserpick.description import dims
+from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse, ray_hit
 from laserpick.pipeline.collision import CollisionChecker, self_filter
 from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
@@ -665,10 +666,16 @@ class Session:
         in view on the way in. In real time the capture runs on its own thread, so the drive
         command does not wait on it; headless, it runs at once, so a run replays exactly."""
         robot = self.robot
-        # Only with the arm stowed and the hand empty, as they are when a grasp is planned:
-        # a view never shows the arm elsewhere, nor an object riding along in the hand.
-        stowed = at_pose(robot.joint_state().q, dims.UR5_HOME_Q)
-        if not stowed or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
+        # With the arm stowed and the hand empty, as they are when a grasp is planned; or
+        # holding what a pick took (tucked in, on the way to a place), whose points are
+        # known and left out of the view with the arm's: the carry to the place is planned
+        # around what the drive saw, where the scooter's own cameras do not look now.
+        if robot.gripper_state().holding:
+            if self.behaviours.held is None:  # something in the hand of unknown shape
+                return
+        elif not at_pose(robot.joint_state().q, dims.UR5_HOME_Q):
+            return
+        if not self.views.due(robot.base_pose()):
             return
         if not robot.sim.realtime:
             self._take_view(robot)
@@ -676,14 +683,15 @@ class Session:
             self._view_job = self._view_pool.submit(self._take_view, robot)
 
     def _take_view(self, robot: SimRobot) -> None:
-        pose, q = robot.base_pose(), robot.joint_state().q
+        pose, q, held = robot.base_pose(), robot.joint_state().q, self.behaviours.held
         try:
             frames = robot.capture()
         except Exception:  # a view is extra evidence; a drive goes on without it
             log.exception("A view on the way could not be captured.")
             return
         if robot is self.robot:  # not a view of a scene replaced meanwhile
-            self.views.add(frames, pose, q)
+            carried = None if held is None else held.at(tcp_pose(q))
+            self.views.add(frames, pose, q, carried)
 
     def _recalled(self) -> Recalled:
         """The views kept on the way in, in `base` as the scooter stands now."""
@@ -878,6 +886,9 @@ class Session:
         grasps = self.task.grasps
         assert grasps is not None
         out = self.behaviours.pick(grasps, order)
+        if self.behaviours.held is not None:
+            # The object has left its place: the views of the way in must not keep it there.
+            self.views.forget(grasps.carried, self.robot.base_pose())
         self.task.timings.update(out.timings)
         if out.grasp is not None:  # the grasp that planned: in auto, not always the first
             self._emit(
@@ -927,7 +938,7 @@ class Session:
         self.task.place_mark = mark.point
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
-        out = self.behaviours.place(cloud, mark.point)
+        out = self.behaviours.place(cloud, mark.point, self._recalled().blind_points(frames))
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)
