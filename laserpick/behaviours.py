@@ -135,13 +135,16 @@ class Outcome:
 class Held:
     """What the hand holds after a pick: the grasp, its height above the support surface (m)
     (for placing, 004 section 7.3), the object's points in the TCP frame (m, thinned, its
-    unseen back filled in by `carried_shape`: the planner carries them with the hand) and the
-    obstacles around it."""
+    unseen back filled in by `carried_shape`: the planner carries them with the hand), the
+    obstacles around it (`base`), and the odometry's pose (x, y, yaw; m, rad) where they
+    were seen (None: not tied to a place). Once the scooter has moved, the obstacles must be
+    taken anew (`Session._held_here`)."""
 
     grasp: Grasp
     height_above_support: float
     points_tcp: np.ndarray
     surroundings: CollisionChecker
+    seen_from: np.ndarray | None = None
 
     def at(self, T_tcp: np.ndarray) -> np.ndarray:
         """The object's points (m, `base`) with the TCP at pose T_tcp (4, 4), `base`."""
@@ -385,7 +388,8 @@ class Behaviours:
         pts = grasps.carried
         pts_tcp = grasp.in_hand(pts)
         around = self._without_leftovers(grasps.surroundings, pts, support)
-        self.held = Held(grasp, float(grasp.position[2] - support), pts_tcp, around)
+        height = float(grasp.position[2] - support)
+        self.held = Held(grasp, height, pts_tcp, around, self.robot.base_pose())
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)

@@ -16,3 +16,14 @@ def drive_back_and_in(session: Session, actor: Actor) -> None:
         for _ in range(10):
             session.drive(actor, 0.0, 0.0, 0.3)
             robot.sleep(0.1)
+
+
+def drive_back(session: Session, actor: Actor, distance: float) -> None:
+    """`distance` m straight back at 0.4 m/s, then a pause of 1 s."""
+    robot = session.robot
+    for _ in range(round(distance / 0.04)):
+        session.drive(actor, -0.4, 0.0, 0.3)
+        robot.sleep(0.1)
+    for _ in range(10):
+        session.drive(actor, 0.0, 0.0, 0.3)
+        robot.sleep(0.1)

@@ -209,3 +209,56 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         assert session.failure.message == f"No way home was found. {PLACED_NOT_STANDING}"
     finally:
         session.close()
+
+
+def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew() -> None:
+    """Picked from the table, the mug is kept (a place cancelled) and the scooter drives
+    1 m back. The drop is then planned around what stands around the hand here, not around
+    the table where it stood at the pick (the odometry puts it 1 m farther away now)."""
+    from driving import drive_back
+
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        robot, actor = session.robot, Actor("bench")
+        referee = Referee(robot)
+        robot.sim.settle(0.3)
+        mug = referee.object_points("mug_1")
+        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
+        session.set_mode(actor, mode="pick_and_place")
+        session.aim_at(actor, centre, "base")
+        session.confirm(actor, point=centre)
+        _wait(lambda: not session.busy, 120.0)
+        session.execute(actor)
+        _wait(lambda: not session.busy, 120.0)
+        assert session.state == TaskState.AWAITING_PLACE, session.message
+        session.cancel(actor)
+        assert session.state == TaskState.HOLDING
+        at_pick = session.behaviours.held
+        assert at_pick is not None and at_pick.seen_from is not None
+
+        def on_the_table(points: np.ndarray) -> int:
+            """Points of the table top (0.46 m) where it stood before the arm at the pick."""
+            top = np.abs(points[:, 2] - 0.46) < 0.01
+            return int((top & (points[:, 0] > 1.2) & (points[:, 0] < 1.6)).sum())
+
+        assert on_the_table(at_pick.surroundings.points) > 100
+        drive_back(session, actor, 1.0)
+        moved = np.linalg.norm(robot.base_pose()[:2] - at_pick.seen_from[:2])
+        assert moved > 0.9
+        planned_around: list = []
+        drop = session.behaviours.drop_in_basket
+
+        def recording_drop() -> Outcome:
+            planned_around.append(session.behaviours.held)
+            return drop()
+
+        session.behaviours.drop_in_basket = recording_drop  # type: ignore[method-assign]
+        session.execute(actor)
+        _wait(lambda: not session.busy, 120.0)
+        here = planned_around[0]
+        assert np.allclose(here.seen_from, robot.base_pose(), atol=0.01)
+        assert on_the_table(here.surroundings.points) == 0
+        assert session.state == TaskState.IDLE and session.failure is None, session.message
+        assert referee.in_basket("mug_1")
+    finally:
+        session.close()

@@ -37,7 +37,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from typing import Any, Literal
 
@@ -47,12 +47,12 @@ from laserpick.behaviours import GRIPPER_TIME, Behaviours, Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse, ray_hit
-from laserpick.pipeline.collision import CollisionChecker, self_filter
+from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
 from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
-from laserpick.pipeline.recall import Recalled, ViewMemory
+from laserpick.pipeline.recall import Recalled, ViewMemory, motion
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.pipeline.surface import still_standing
 from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
@@ -85,6 +85,10 @@ WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
 IO_STALL_MAX = 2.0
 #: A capture older than this (s) is not reused for aiming or a clicked mark.
 CAPTURE_MAX_AGE = 5.0
+#: The scooter has moved since the pick once the odometry says this far (m) or this turn
+#: (rad): the planner's clearance. What stood around the held object is then taken anew.
+HELD_MOVED = 0.01
+HELD_TURNED = math.radians(1.0)
 
 
 class TaskState(StrEnum):
@@ -915,6 +919,7 @@ class Session:
             self._set(TaskState.AWAITING_PLACE, "Mark where to put it, then confirm.")
 
     def _drop_job(self) -> None:
+        self._held_here()
         out = self.behaviours.drop_in_basket()
         if not out.ok:
             assert out.failure is not None
@@ -971,6 +976,30 @@ class Session:
             frames=(*capture.frames, *recalled.frames),
         )
 
+    def _held_here(self) -> None:
+        """Where the scooter has moved since the pick with the object in hand, take anew what
+        stands around the hand (`Held.surroundings`, which the tuck and the drop are planned
+        around): the pick's are where the scooter stood then, and after a place refused at
+        the other end of the kitchen the tuck went around them, not around the counter before
+        the hand. A capture here, with the views of the drive (`_surroundings`), less the held
+        object's own points; where the cameras fail, the pick's, carried here by the
+        odometry."""
+        held, now = self.behaviours.held, self.robot.base_pose()
+        if held is None or held.seen_from is None:
+            return
+        T = motion(held.seen_from, now)
+        turned = abs(math.atan2(T[1, 0], T[0, 0]))
+        if math.hypot(*T[:2, 3]) < HELD_MOVED and turned < HELD_TURNED:
+            return
+        q = self.robot.joint_state().q
+        around = self._surroundings(self._try_look())
+        if around is None:
+            pts = held.surroundings.points @ T[:3, :3].T + T[:3, 3]
+            around = CollisionChecker(pts, margin=held.surroundings.margin, filtered=True)
+        else:
+            around = around.without(~not_carried(around.points, held.at(tcp_pose(q))))
+        self.behaviours.held = replace(held, surroundings=around, seen_from=now)
+
     def _stow_and_rest(self, message: str, placed: Outcome | None = None) -> None:
         """Stow and rest, saying `message`; after a place (`placed`), first check from the
         same capture that the object still stands where it was let go."""
@@ -1014,6 +1043,7 @@ class Session:
         b = self.behaviours
         if b.held is not None and self.robot.gripper_state().holding:
             self._progress("Tucking in what the hand holds.")
+            self._held_here()
             b.tuck()
         else:
             if self.robot.gripper_state().closed:
