@@ -710,17 +710,12 @@ class Behaviours:
                     return back
         return back
 
-    def place(
-        self, cloud: FusedCloud, mark: np.ndarray, blind: np.ndarray | None = None
-    ) -> Outcome:
+    def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
         """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).
 
         cloud: a fresh capture's fused cloud (the held object and the arm in it are ignored);
-        mark: the place mark (m, `base`); blind: what the views of the drive saw where no
-        camera sees now (`Recalled.blind_points`, m, `base`), obstacles to the carry too.
-
-        The mark must be on a flat surface (moved back from its front edge if it is too
-        close). The object goes down with the grasp's orientation
+        mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
+        its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), then the
         hand opens and leaves it (drawn back along its approach where that way is clear, else
@@ -737,11 +732,7 @@ class Behaviours:
         if isinstance(spot, Failure):
             return Outcome(Failure("precondition", f"I can't place there: {spot.message}."))
         q_now = self._q()
-        # A counter the scooter parked beside may lie in no camera's view, and the carry
-        # from the tucked pose swept the hand through it (151-166 N): what the views of the
-        # drive saw there stands in for it.
-        pts = cloud.points if blind is None or not len(blind) else np.vstack([cloud.points, blind])
-        obstacles = pts[not_carried(pts, held.at(tcp_pose(q_now)))]
+        obstacles = cloud.points[not_carried(cloud.points, held.at(tcp_pose(q_now)))]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
         found = self._place_poses(held, spot, q_now, checker)
         if isinstance(found, Failure):

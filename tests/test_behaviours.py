@@ -614,21 +614,6 @@ def test_something_met_well_above_the_surface_keeps_the_object(robot):
     assert referee.object_points("mug_1", frame="world")[:, 2].min() > TABLE_TOP + 0.015
 
 
-def test_what_the_drive_saw_where_no_camera_looks_now_stands_in_the_way_of_a_place(robot):
-    """A shelf board 16 cm over the table at the mark, which no camera sees now but a view
-    of the drive did (`Recalled.blind_points`): the object is not carried in under it, and
-    the hand keeps it. The same mark without the board is placed (the test above)."""
-    b, referee = _pick(robot, "mug_1")
-    assert b.tuck().ok
-    mark = np.array([1.45, -0.55, TABLE_TOP])
-    xs, ys = np.meshgrid(np.arange(1.25, 1.66, 0.01), np.arange(-0.75, -0.34, 0.01))
-    board = np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, TABLE_TOP + 0.16)])
-    out = b.place(fuse(robot.capture()), mark, blind=board)
-    assert out.failure is not None and out.failure.kind == "ik_plan", out.failure
-    assert robot.gripper_state().holding and b.held is not None
-    assert referee.object_points("mug_1", frame="world")[:, 2].min() > TABLE_TOP + 0.05
-
-
 def _box_points(size: tuple[float, float, float], step: float = 0.01) -> np.ndarray:
     """Points (m) filling a box of `size` whose top face's middle is the origin, reaching
     down along +z: a box held at its top by a downward hand, in the TCP frame."""

@@ -162,20 +162,13 @@ class ViewMemory:
         return moved >= self.spacing or _turn(pose[2], last[2]) >= self.turn
 
     def add(
-        self,
-        frames: Sequence[DepthFrame],
-        pose: np.ndarray,
-        q_arm: np.ndarray | None = None,
-        carried: np.ndarray | None = None,
+        self, frames: Sequence[DepthFrame], pose: np.ndarray, q_arm: np.ndarray | None = None
     ) -> None:
         """Keep a capture taken at odometry `pose`; the oldest goes beyond `size`. q_arm (6,)
         (rad): the arm's joint angles in the capture (None: no arm in view). Its own points
         are left out (`self_filter`), as the planner leaves them out of a capture now: carried
         to where the scooter stands now, they would be a ghost of the arm, in the very place
-        it folds into (the stow after the first drop found no way home in every in-situ task).
-        carried (M, 3): the points of what the hand holds in the capture (m, `base`), left out
-        as well (`not_carried`): it travels with the hand, and its ghost would stand where
-        the hand starts from."""
+        it folds into (the stow after the first drop found no way home in every in-situ task)."""
         if self.size == 0 or not frames:
             return
         # The workspace box, reaching as much farther ahead as the views span: what lay
@@ -185,8 +178,6 @@ class ViewMemory:
         points = fuse(frames, s.model_copy(update={"workspace_max": far})).points
         if q_arm is not None:
             points = points[self_filter(points, q_arm)]
-        if carried is not None:
-            points = points[not_carried(points, carried)]
         view = View(tuple(frames), points[voxel_first(points, VIEW_VOXEL)], np.array(pose, float))
         with self._lock:
             self._views = (*self._views, view)[-self.size :]

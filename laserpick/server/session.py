@@ -670,16 +670,10 @@ class Session:
         in view on the way in. In real time the capture runs on its own thread, so the drive
         command does not wait on it; headless, it runs at once, so a run replays exactly."""
         robot = self.robot
-        # With the arm stowed and the hand empty, as they are when a grasp is planned; or
-        # holding what a pick took (tucked in, on the way to a place), whose points are
-        # known and left out of the view with the arm's: the carry to the place is planned
-        # around what the drive saw, where the scooter's own cameras do not look now.
-        if robot.gripper_state().holding:
-            if self.behaviours.held is None:  # something in the hand of unknown shape
-                return
-        elif not at_pose(robot.joint_state().q, dims.UR5_HOME_Q):
-            return
-        if not self.views.due(robot.base_pose()):
+        # Only with the arm stowed and the hand empty, as they are when a grasp is planned:
+        # a view never shows the arm elsewhere, nor an object riding along in the hand.
+        stowed = at_pose(robot.joint_state().q, dims.UR5_HOME_Q)
+        if not stowed or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
             return
         if not robot.sim.realtime:
             self._take_view(robot)
@@ -687,15 +681,14 @@ class Session:
             self._view_job = self._view_pool.submit(self._take_view, robot)
 
     def _take_view(self, robot: SimRobot) -> None:
-        pose, q, held = robot.base_pose(), robot.joint_state().q, self.behaviours.held
+        pose, q = robot.base_pose(), robot.joint_state().q
         try:
             frames = robot.capture()
         except Exception:  # a view is extra evidence; a drive goes on without it
             log.exception("A view on the way could not be captured.")
             return
         if robot is self.robot:  # not a view of a scene replaced meanwhile
-            carried = None if held is None else held.at(tcp_pose(q))
-            self.views.add(frames, pose, q, carried)
+            self.views.add(frames, pose, q)
 
     def _recalled(self) -> Recalled:
         """The views kept on the way in, in `base` as the scooter stands now."""
@@ -943,7 +936,7 @@ class Session:
         self.task.place_mark = mark.point
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
-        out = self.behaviours.place(cloud, mark.point, self._recalled().blind_points(frames))
+        out = self.behaviours.place(cloud, mark.point)
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)
