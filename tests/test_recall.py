@@ -155,6 +155,14 @@ def test_the_memory_forgets_what_was_picked_up_where_it_stood():
     beyond = wall[cKDTree(patch).query(wall)[0] > 0.05]
     d, _ = cKDTree(left).query(beyond)
     assert len(beyond) > 100 and d.max() < 1e-6  # the wall beyond the padding is all there
+    # What lies lower than `above` stays: the patch's lower half, as a surface would.
+    memory = ViewMemory(0.1, 0.1, 4, 60.0)
+    memory.add([_wall_frame(then)], then)
+    middle = float(np.median(patch[:, 2]))
+    memory.forget(patch @ T[:3, :3].T + T[:3, 3], now, above=middle)
+    left = memory.recall(then, now=0.0).points
+    d, _ = cKDTree(patch).query(left)
+    assert (left[d < 0.01][:, 2] <= middle + 1e-6).all() and (d < 0.01).sum() > 20
 
 
 def test_a_view_adds_its_points_only_where_no_camera_sees_now():

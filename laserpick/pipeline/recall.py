@@ -182,10 +182,12 @@ class ViewMemory:
         with self._lock:
             self._views = (*self._views, view)[-self.size :]
 
-    def forget(self, points: np.ndarray, pose: np.ndarray) -> None:
+    def forget(self, points: np.ndarray, pose: np.ndarray, above: float = -np.inf) -> None:
         """Leave out of every view what it saw within CARRIED_PADDING of `points` (m, `base`
-        as the scooter stands at odometry `pose`): an object picked up since, whose ghost
-        would otherwise stand where it was, wherever no camera sees it gone now."""
+        as the scooter stands at odometry `pose`) and higher than `above` (m): an object
+        picked up since, whose ghost would otherwise stand where it was, wherever no camera
+        sees it gone now. The surface it stood on, below `above`, stays. (`base` heights do
+        not change as the scooter drives.)"""
         if len(points) == 0:
             return
         pts = np.asarray(points, float)
@@ -194,7 +196,8 @@ class ViewMemory:
             for view in self._views:
                 T = motion(np.asarray(pose, float), view.pose)
                 then = pts @ T[:3, :3].T + T[:3, 3]
-                kept.append(replace(view, points=view.points[not_carried(view.points, then)]))
+                gone = ~not_carried(view.points, then) & (view.points[:, 2] > above)
+                kept.append(replace(view, points=view.points[~gone]))
             self._views = tuple(kept)
 
     def clear(self) -> None:

@@ -43,7 +43,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from laserpick.behaviours import GRIPPER_TIME, Behaviours, Outcome
+from laserpick.behaviours import GRIPPER_TIME, SUPPORT_SCATTER, Behaviours, Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse, ray_hit
@@ -885,7 +885,8 @@ class Session:
         out = self.behaviours.pick(grasps, order)
         if self.behaviours.held is not None:
             # The object has left its place: the views of the way in must not keep it there.
-            self.views.forget(grasps.carried, self.robot.base_pose())
+            above = grasps.stands_on + SUPPORT_SCATTER
+            self.views.forget(grasps.carried, self.robot.base_pose(), above)
         self.task.timings.update(out.timings)
         if out.grasp is not None:  # the grasp that planned: in auto, not always the first
             self._emit(
@@ -972,9 +973,9 @@ class Session:
     def _held_here(self) -> None:
         """Where the scooter has moved since the pick with the object in hand, take anew what
         stands around the hand (`Held.surroundings`, which the tuck and the drop are planned
-        around): the pick's are where the scooter stood then, and after a place refused at
-        the other end of the kitchen the tuck went around them, not around the counter before
-        the hand. A capture here, with the views of the drive (`_surroundings`), less the held
+        around): the pick's stand where they stood before the scooter then, so the tuck
+        after a place refused elsewhere went around them, and not around what stands before
+        the hand now. A capture here, with the views of the drive (`_surroundings`), less the held
         object's own points; where the cameras fail, the pick's, carried here by the
         odometry."""
         held, now = self.behaviours.held, self.robot.base_pose()
