@@ -269,6 +269,10 @@ def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) ->
         ws.close()
         time.sleep(1.5)
     finally:
+        # Whatever failed above, the heartbeats stop and the socket closes, so that the
+        # lease lapses: beating on, it held control through every later test (409s).
+        beating.clear()
+        ws.close()
         watcher.close()
     after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
     assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
