@@ -6,8 +6,9 @@ import dataclasses
 import time
 
 import numpy as np
+from driving import drive_back
 
-from laserpick.behaviours import Outcome
+from laserpick.behaviours import Held, Outcome
 from laserpick.bench.operator import Referee
 from laserpick.pipeline.types import Failure
 from laserpick.robot.scenes import load_scene
@@ -215,8 +216,6 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
     """Picked from the table, the mug is kept (a place cancelled) and the scooter drives
     1 m back. The drop is then planned around what stands around the hand here, not around
     the table where it stood at the pick (the odometry puts it 1 m farther away now)."""
-    from driving import drive_back
-
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
         robot, actor = session.robot, Actor("bench")
@@ -245,7 +244,7 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
         drive_back(session, actor, 1.0)
         moved = np.linalg.norm(robot.base_pose()[:2] - at_pick.seen_from[:2])
         assert moved > 0.9
-        planned_around: list = []
+        planned_around: list[Held | None] = []
         drop = session.behaviours.drop_in_basket
 
         def recording_drop() -> Outcome:
@@ -256,6 +255,7 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
         session.execute(actor)
         _wait(lambda: not session.busy, 120.0)
         here = planned_around[0]
+        assert here is not None
         assert np.allclose(here.seen_from, robot.base_pose(), atol=0.01)
         assert on_the_table(here.surroundings.points) == 0
         assert session.state == TaskState.IDLE and session.failure is None, session.message
