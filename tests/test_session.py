@@ -6,7 +6,7 @@ import dataclasses
 import time
 
 import numpy as np
-from driving import drive_back
+from driving import drive_straight
 
 from laserpick.behaviours import Held, Outcome
 from laserpick.bench.operator import Referee
@@ -241,7 +241,7 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
             return int((top & (points[:, 0] > 1.2) & (points[:, 0] < 1.6)).sum())
 
         assert on_the_table(at_pick.surroundings.points) > 100
-        drive_back(session, actor, 1.0)
+        drive_straight(session, actor, -0.4, 1.0)
         moved = np.linalg.norm(robot.base_pose()[:2] - at_pick.seen_from[:2])
         assert moved > 0.9
         planned_around: list[Held | None] = []

@@ -121,6 +121,13 @@ def _turn(a: float, b: float) -> float:
     return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
 
 
+def moved(then: np.ndarray, now: np.ndarray, distance: float, turn: float) -> bool:
+    """Whether the scooter, from odometry pose `then` to `now` (x, y, yaw; m, rad), has gone
+    at least `distance` (m) or turned at least `turn` (rad)."""
+    gone = math.hypot(now[0] - then[0], now[1] - then[1])
+    return gone >= distance or _turn(now[2], then[2]) >= turn
+
+
 def motion(then: np.ndarray, now: np.ndarray) -> np.ndarray:
     """T (4, 4) taking `base` at odometry pose `then` (x, y, yaw) into `base` at `now`."""
     return invert(planar_pose(*now)) @ planar_pose(*then)
@@ -157,9 +164,7 @@ class ViewMemory:
         views = self._views
         if not views:
             return True
-        last = views[-1].pose
-        moved = math.hypot(pose[0] - last[0], pose[1] - last[1])
-        return moved >= self.spacing or _turn(pose[2], last[2]) >= self.turn
+        return moved(views[-1].pose, pose, self.spacing, self.turn)
 
     def add(
         self, frames: Sequence[DepthFrame], pose: np.ndarray, q_arm: np.ndarray | None = None

@@ -52,7 +52,7 @@ from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
-from laserpick.pipeline.recall import Recalled, ViewMemory, motion
+from laserpick.pipeline.recall import Recalled, ViewMemory, motion, moved
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.pipeline.surface import still_standing
 from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
@@ -981,13 +981,12 @@ class Session:
         held, now = self.behaviours.held, self.robot.base_pose()
         if held is None or held.seen_from is None:
             return
-        T = motion(held.seen_from, now)
-        turned = abs(math.atan2(T[1, 0], T[0, 0]))
-        if math.hypot(*T[:2, 3]) < HELD_MOVED and turned < HELD_TURNED:
+        if not moved(held.seen_from, now, HELD_MOVED, HELD_TURNED):
             return
         q = self.robot.joint_state().q
         around = self._surroundings(self._try_look())
         if around is None:
+            T = motion(held.seen_from, now)
             pts = held.surroundings.points @ T[:3, :3].T + T[:3, 3]
             around = CollisionChecker(pts, margin=held.surroundings.margin, filtered=True)
         else:
