@@ -27,6 +27,7 @@ from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     CollisionChecker,
+    held_at,
     not_carried,
     obstacle_mask,
     surface_front,
@@ -535,7 +536,7 @@ class Behaviours:
         Q = np.array(candidates)
         T = tcp_pose(Q)
         pts = payload if len(payload) else np.zeros((1, 3))
-        held = np.einsum("bij,pj->bpi", T[:, :3, :3], pts) + T[:, None, :3, 3]  # (B, P, 3)
+        held = held_at(T, pts)  # (B, P, 3)
         xy = held[..., :2]
         middle = xy.mean(axis=1)
         middle_in = np.all((middle >= lo) & (middle <= hi), axis=1)

@@ -112,8 +112,13 @@ def sphere_centres(frames: np.ndarray, model: SphereModel = SPHERES) -> np.ndarr
 def held_points(frames: np.ndarray, payload: np.ndarray) -> np.ndarray:
     """Where (B, P, 3; m, `base`) the points `payload` (P, 3; m, TCP frame) of a held object
     are with the arm at body frames (B, 7, 4, 4)."""
-    T = frames[:, 6] @ T_FLANGE_TCP
-    return np.einsum("bij,pj->bpi", T[:, :3, :3], payload) + T[:, None, :3, 3]
+    return held_at(frames[:, 6] @ T_FLANGE_TCP, payload)
+
+
+def held_at(T_tcp: np.ndarray, payload: np.ndarray) -> np.ndarray:
+    """Where (B, P, 3; m, `base`) the points `payload` (P, 3; m, TCP frame) of a held object
+    are with the TCP at poses `T_tcp` (B, 4, 4; `base`)."""
+    return np.einsum("bij,pj->bpi", T_tcp[:, :3, :3], payload) + T_tcp[:, None, :3, 3]
 
 
 def held_clear_of_arm(Q: np.ndarray, payload: np.ndarray, margin: float) -> np.ndarray:
