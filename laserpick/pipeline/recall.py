@@ -133,6 +133,12 @@ def motion(then: np.ndarray, now: np.ndarray) -> np.ndarray:
     return invert(planar_pose(*now)) @ planar_pose(*then)
 
 
+def moved_points(points: np.ndarray, then: np.ndarray, now: np.ndarray) -> np.ndarray:
+    """`points` (N, 3; m, `base` at odometry pose `then`) in `base` at odometry pose `now`."""
+    T = motion(then, now)
+    return points @ T[:3, :3].T + T[:3, 3]
+
+
 class ViewMemory:
     """The last `size` views of a drive, one each `spacing` m driven or `turn` rad turned,
     none older than `max_age` s of robot time. Thread-safe: the session adds views on one
@@ -199,8 +205,7 @@ class ViewMemory:
         with self._lock:
             kept = []
             for view in self._views:
-                T = motion(np.asarray(pose, float), view.pose)
-                then = pts @ T[:3, :3].T + T[:3, 3]
+                then = moved_points(pts, np.asarray(pose, float), view.pose)
                 gone = ~not_carried(view.points, then) & (view.points[:, 2] > above)
                 kept.append(replace(view, points=view.points[~gone]))
             self._views = tuple(kept)

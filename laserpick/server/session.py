@@ -52,7 +52,7 @@ from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
 from laserpick.pipeline.laser import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
-from laserpick.pipeline.recall import Recalled, ViewMemory, motion, moved
+from laserpick.pipeline.recall import Recalled, ViewMemory, moved, moved_points
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.pipeline.surface import still_standing
 from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
@@ -986,8 +986,7 @@ class Session:
         q = self.robot.joint_state().q
         around = self._surroundings(self._try_look())
         if around is None:
-            T = motion(held.seen_from, now)
-            pts = held.surroundings.points @ T[:3, :3].T + T[:3, 3]
+            pts = moved_points(held.surroundings.points, held.seen_from, now)
             around = CollisionChecker(pts, margin=held.surroundings.margin, filtered=True)
         else:
             around = around.without(~not_carried(around.points, held.at(tcp_pose(q))))
