@@ -17,7 +17,7 @@ import itertools
 import logging
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -117,7 +117,9 @@ class Outcome:
     spot: where a place set the object down (the surface point under the TCP, m, `base`);
     standing: the object there as the hand let it go (its carried shape, m, `base`);
     closed_width: a pick's finger gap once it has squeezed again after the first lift (m),
-    beside `grasp.width`, the width it planned: an object turned in the pads shows less."""
+    beside `grasp.width`, the width it planned: an object turned in the pads shows less;
+    caution: a sentence for the user about what went otherwise than planned, which no sensor
+    can confirm (an object let go partly past the basket's opening)."""
 
     failure: Failure | None = None
     grasp: Grasp | None = None
@@ -126,6 +128,7 @@ class Outcome:
     spot: np.ndarray | None = None
     standing: np.ndarray | None = None
     closed_width: float | None = None
+    caution: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -191,6 +194,28 @@ def drop_candidates(tilted: bool = False) -> tuple[np.ndarray, ...]:
         Q = ik_tcp(T, dims.UR5_READY_Q)
         out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
     return tuple(out)
+
+
+#: What the user is told when the hand let go of an object partly past the basket's opening
+#: (no posture held it wholly over it): no camera sees the basket, and a cereal box let go so
+#: lay across both walls, where the next carry to the basket met it (in-situ, 154 N).
+PAST_THE_OPENING = (
+    "Part of it reached past the basket's opening when the hand let go, so it may lie on"
+    " the rim or beside the basket: please check before the next drop."
+)
+
+
+def basket_opening() -> tuple[np.ndarray, np.ndarray]:
+    """The basket's opening, 1 cm in from its walls: its lower and upper corners (m, `base`
+    xy)."""
+    half = dims.BASKET_INNER[:2] / 2
+    return dims.BASKET_CENTER[:2] - half + 0.01, dims.BASKET_CENTER[:2] + half - 0.01
+
+
+def over_the_opening(held: np.ndarray) -> np.ndarray:
+    """Whether each point of `held` (..., 3) (m, `base`) lies over the basket's opening."""
+    lo, hi = basket_opening()
+    return np.all((held[..., :2] >= lo) & (held[..., :2] <= hi), axis=-1)
 
 
 class Behaviours:
@@ -530,23 +555,19 @@ class Behaviours:
         its rank key (see `drop_configurations`), sorted."""
         if not candidates:
             return []
-        lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2 + 0.01
-        hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2 - 0.01
         floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
         Q = np.array(candidates)
         T = tcp_pose(Q)
         pts = payload if len(payload) else np.zeros((1, 3))
         held = held_at(T, pts)  # (B, P, 3)
-        xy = held[..., :2]
-        middle = xy.mean(axis=1)
-        middle_in = np.all((middle >= lo) & (middle <= hi), axis=1)
-        Q, held, xy = Q[middle_in], held[middle_in], xy[middle_in]
+        middle_in = over_the_opening(held.mean(axis=1))
+        Q, held = Q[middle_in], held[middle_in]
         # In chunks: the check's arrays grow with candidates x payload points x spheres.
         clear = np.concatenate(
             [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
             or [np.zeros(0, bool)]
         )
-        inside = (~np.all((xy >= lo) & (xy <= hi), axis=(1, 2))).astype(int)
+        inside = (~np.all(over_the_opening(held), axis=1)).astype(int)
         fall = ((held[..., 2].min(axis=1) - floor) // FALL_STEP).astype(int)
         near = np.max(np.abs(Q - q_ref), axis=1)
         ranked = [
@@ -654,7 +675,8 @@ class Behaviours:
 
     def drop_in_basket(self) -> Outcome:
         """Carry what the hand holds to the basket, release it, and return to ready (stowed
-        where neither ready pose is clear)."""
+        where neither ready pose is clear). Let go partly past the basket's opening, the
+        outcome says so (`PAST_THE_OPENING`): as its caution, or in its failure."""
         if self.held is None or not self.robot.gripper_state().holding:
             self.held = None
             return Outcome(Failure("precondition", "The hand is not holding anything."))
@@ -692,6 +714,16 @@ class Behaviours:
         # a protective stop). The object can only have fallen from where the hand let go.
         T = tcp_pose(self._q())
         let_go = held.at(T)
+        caution = None if over_the_opening(let_go).all() else PAST_THE_OPENING
+
+        def said(out: Outcome) -> Outcome:
+            if caution is None:
+                return out
+            if out.failure is None:
+                return replace(out, caution=caution)
+            failure = Failure(out.failure.kind, f"{out.failure.message} {caution}")
+            return replace(out, failure=failure)
+
         around = CollisionChecker(
             np.vstack([held.surroundings.points, let_go]),
             margin=self.settings.motion.clearance,
@@ -699,7 +731,7 @@ class Behaviours:
         )
         failure = self._rise_clear(around, hand_on_the_way=False)
         if failure is not None:
-            return Outcome(failure)
+            return said(Outcome(failure))
         # Around the object as it was let go, else as it fell, lower (no way around it). To
         # ready; parked at a shelf or a high table, whose boards fill both ready poses (10 of
         # 67 in-situ attempts once ended there, the object in the basket), folded away from
@@ -708,8 +740,8 @@ class Behaviours:
             for checker in (around, held.surroundings):
                 back = leave(checker)
                 if back.failure is None or back.failure.kind != "ik_plan":
-                    return back
-        return back
+                    return said(back)
+        return said(back)
 
     def place(self, cloud: FusedCloud, mark: np.ndarray) -> Outcome:
         """Set what the hand holds down at a place mark (004 section 7.3, EL-E 000 4.5).

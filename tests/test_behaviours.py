@@ -281,6 +281,7 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     assert referee.position(name)[2] > TABLE_TOP + 0.08, "lifted"
     dropped = b.drop_in_basket()
     assert dropped.ok, dropped.failure
+    assert dropped.caution is None, "let go wholly over the opening"
     robot.sleep(1.0)
     assert referee.in_basket(name)
     assert not robot.gripper_state().closed

@@ -919,7 +919,7 @@ class Session:
             assert out.failure is not None
             self._end_badly(out.failure)
             return
-        self._stow_and_rest("Dropped in the basket.")
+        self._stow_and_rest("Dropped in the basket." + (f" {out.caution}" if out.caution else ""))
 
     def _place_job(self) -> None:
         with self._lock:
