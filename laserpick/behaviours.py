@@ -59,6 +59,15 @@ DROP_HEIGHTS = (0.06, 0.10, 0.14, 0.20, 0.26)
 DROP_TRIES = 3
 #: Falls (m) that differ by less than this rank alike when choosing a drop posture.
 FALL_STEP = 0.04
+#: Where no posture holds the whole object over the basket's opening, upright and tilted
+#: ones rank together: by the fall in steps of OVERHANG_FALL_STEP (m), then by how far they
+#: hold the object past the opening, in steps of OVERHANG_STEP (m), then as those that hold
+#: it inside. A cereal box held at its top, let go from an upright posture 12 cm past a
+#: wall, toppled across the opening onto both walls (in-situ), where the next carry to the
+#: basket met it (154 N); let go tilted 3.7 cm past, from as high, it fell in. Ranked by
+#: the reach past alone, the box went from 6 cm higher and bounced out (isolation).
+OVERHANG_FALL_STEP = 0.08
+OVERHANG_STEP = 0.01
 #: Highest extra lift (m) to bring a held object clear before carrying it, in steps of
 #: RISE_STEP (m).
 RISE_MAX = 0.20
@@ -531,8 +540,9 @@ class Behaviours:
         top fitted inside from one upright posture only, which no path reached).
 
         Postures that hold every point of the object inside the opening (1 cm in from the
-        walls) come first, then those that hold its middle there; then the shortest fall
-        (in FALL_STEP steps: a long fall bounces the object out); then the nearest to q_ref.
+        walls) come first, upright before tilted, each by the shortest fall (in FALL_STEP
+        steps: a long fall bounces the object out), then the nearest to q_ref. Then those
+        that hold its middle there, upright and tilted together (see OVERHANG_STEP).
         A posture that does not hold even the middle over the opening is left out: an object
         let go there would fall beside the basket, onto the scooter or the floor. Empty when
         none is left.
@@ -542,6 +552,9 @@ class Behaviours:
         ranked = self._rank_drops(drop_candidates(), q_ref, checker, payload)
         if sum(key[0] == 0 for key, _ in ranked) < DROP_TRIES:
             ranked += self._rank_drops(drop_candidates(tilted=True), q_ref, checker, payload)
+            inside = [kq for kq in ranked if kq[0][0] == 0]
+            past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
+            ranked = inside + past
         return [q for _, q in ranked]
 
     @staticmethod
@@ -550,7 +563,7 @@ class Behaviours:
         q_ref: np.ndarray,
         checker: CollisionChecker,
         payload: np.ndarray,
-    ) -> list[tuple[tuple[int, int, float], np.ndarray]]:
+    ) -> list[tuple[tuple[int, int, int, int, float], np.ndarray]]:
         """The clear `candidates` that hold the object's middle over the opening, each with
         its rank key (see `drop_configurations`), sorted."""
         if not candidates:
@@ -567,11 +580,22 @@ class Behaviours:
             [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
             or [np.zeros(0, bool)]
         )
-        inside = (~np.all(over_the_opening(held), axis=1)).astype(int)
-        fall = ((held[..., 2].min(axis=1) - floor) // FALL_STEP).astype(int)
+        lo, hi = basket_opening()
+        xy = held[..., :2]
+        past = np.maximum(np.maximum(lo - xy, xy - hi), 0.0).max(axis=(1, 2))
+        past = np.ceil(past / OVERHANG_STEP - 1e-9).astype(int)  # 0: wholly inside
+        drop = held[..., 2].min(axis=1) - floor
+        fall = (drop // FALL_STEP).astype(int)
+        coarse = (drop // OVERHANG_FALL_STEP).astype(int)
         near = np.max(np.abs(Q - q_ref), axis=1)
         ranked = [
-            ((int(inside[i]), int(fall[i]), float(near[i])), Q[i]) for i in np.flatnonzero(clear)
+            (
+                (0, 0, 0, int(fall[i]), float(near[i]))
+                if past[i] == 0
+                else (1, int(coarse[i]), int(past[i]), int(fall[i]), float(near[i])),
+                Q[i],
+            )
+            for i in np.flatnonzero(clear)
         ]
         ranked.sort(key=lambda kq: kq[0])
         return ranked
