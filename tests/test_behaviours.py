@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 from pathlib import Path
 
 import numpy as np
@@ -13,11 +14,15 @@ import pytest
 
 from laserpick.behaviours import (
     DROP_TRIES,
+    FALL_STEP,
+    OVERHANG_FALL_STEP,
+    OVERHANG_STEP,
     PLACE_YAWS,
     SUPPORT_SCATTER,
     Behaviours,
     Held,
     Outcome,
+    basket_opening,
     drop_candidates,
     turned_hand_xy,
 )
@@ -643,6 +648,40 @@ def test_a_tall_object_held_at_its_top_is_laid_over_the_basket(robot):
         assert np.all((middle > lo) & (middle < hi))
         assert held[:, 2].min() > dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
         assert free.clearance_ok(q, payload=payload)[0]
+
+
+def _past_and_fall(q: np.ndarray, payload: np.ndarray) -> tuple[int, float]:
+    """How far the object held at joint angles q reaches past the basket's opening (1 cm in
+    from its walls), in OVERHANG_STEP steps (0: wholly over it), and how far its lowest
+    point is above the basket's floor (m)."""
+    lo, hi = basket_opening()
+    T = tcp_pose(q)
+    held = payload @ T[:3, :3].T + T[:3, 3]
+    past = float(np.maximum(np.maximum(lo - held[:, :2], held[:, :2] - hi), 0.0).max())
+    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    return math.ceil(past / OVERHANG_STEP - 1e-9), float(held[:, 2].min() - floor)
+
+
+def test_postures_that_hold_an_object_partly_past_the_opening_rank_upright_and_tilted_together(
+    robot,
+):
+    """No posture holds a box 24 cm long wholly over the opening. Upright and tilted
+    postures then rank together, by the fall in OVERHANG_FALL_STEP steps and then by how far
+    they hold it past the opening: from an upright posture ranked first for coming first, a
+    cereal box held 12 cm past a wall toppled across the opening onto both walls (in-situ),
+    where the next carry to the basket met it (154 N); from a tilted one 3.7 cm past, it fell
+    in."""
+    payload = _box_points((0.24, 0.11, 0.12))
+    free = CollisionChecker(np.zeros((0, 3)))
+    drops = Behaviours(robot).drop_configurations(dims.UR5_READY_Q, free, payload)
+    keys = [_past_and_fall(q, payload) for q in drops]
+    assert len(drops) > 3 and min(past for past, _ in keys) > 0, "none holds it inside"
+    ranked = [
+        (int(fall // OVERHANG_FALL_STEP), past, int(fall // FALL_STEP)) for past, fall in keys
+    ]
+    assert ranked == sorted(ranked), "by the fall in coarse steps, then by the reach past"
+    upright = [any(np.allclose(q, u) for u in drop_candidates()) for q in drops]
+    assert any(upright) and not upright[0], "a tilted posture before the upright ones"
 
 
 def test_an_object_that_fits_the_basket_from_few_upright_postures_may_also_be_laid_over_it(
