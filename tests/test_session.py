@@ -212,6 +212,25 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         session.close()
 
 
+def _mug_kept(session: Session, actor: Actor) -> Held:
+    """Pick the isolation scene's mug in pick-and-place and cancel its place, so that the
+    session holds it; what the hand holds."""
+    session.robot.sim.settle(0.3)
+    mug = Referee(session.robot).object_points("mug_1")
+    centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
+    session.set_mode(actor, mode="pick_and_place")
+    session.aim_at(actor, centre, "base")
+    session.confirm(actor, point=centre)
+    _wait(lambda: not session.busy, 120.0)
+    session.execute(actor)
+    _wait(lambda: not session.busy, 120.0)
+    assert session.state == TaskState.AWAITING_PLACE, session.message
+    session.cancel(actor)
+    assert session.state == TaskState.HOLDING
+    assert session.behaviours.held is not None
+    return session.behaviours.held
+
+
 def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew() -> None:
     """Picked from the table, the mug is kept (a place cancelled) and the scooter drives
     1 m back. The drop is then planned around what stands around the hand here, not around
@@ -220,20 +239,8 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
     try:
         robot, actor = session.robot, Actor("bench")
         referee = Referee(robot)
-        robot.sim.settle(0.3)
-        mug = referee.object_points("mug_1")
-        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
-        session.set_mode(actor, mode="pick_and_place")
-        session.aim_at(actor, centre, "base")
-        session.confirm(actor, point=centre)
-        _wait(lambda: not session.busy, 120.0)
-        session.execute(actor)
-        _wait(lambda: not session.busy, 120.0)
-        assert session.state == TaskState.AWAITING_PLACE, session.message
-        session.cancel(actor)
-        assert session.state == TaskState.HOLDING
-        at_pick = session.behaviours.held
-        assert at_pick is not None and at_pick.seen_from is not None
+        at_pick = _mug_kept(session, actor)
+        assert at_pick.seen_from is not None
 
         def on_the_table(points: np.ndarray) -> int:
             """Points of the table top (0.46 m) where it stood before the arm at the pick."""
@@ -272,20 +279,8 @@ def test_a_drop_let_go_partly_past_the_basket_opening_asks_the_user_to_check() -
     it holds the box."""
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
-        robot, actor = session.robot, Actor("bench")
-        robot.sim.settle(0.3)
-        mug = Referee(robot).object_points("mug_1")
-        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
-        session.set_mode(actor, mode="pick_and_place")
-        session.aim_at(actor, centre, "base")
-        session.confirm(actor, point=centre)
-        _wait(lambda: not session.busy, 120.0)
-        session.execute(actor)
-        _wait(lambda: not session.busy, 120.0)
-        assert session.state == TaskState.AWAITING_PLACE, session.message
-        session.cancel(actor)
-        held = session.behaviours.held
-        assert held is not None
+        actor = Actor("bench")
+        held = _mug_kept(session, actor)
         box = np.mgrid[-0.095:0.0951:0.019, -0.03:0.0301:0.015, 0.0:0.2401:0.02].reshape(3, -1).T
         session.behaviours.held = dataclasses.replace(held, points_tcp=box)
         session.execute(actor)
