@@ -583,7 +583,8 @@ class Behaviours:
         lo, hi = basket_opening()
         xy = held[..., :2]
         past = np.maximum(np.maximum(lo - xy, xy - hi), 0.0).max(axis=(1, 2))
-        past = np.ceil(past / OVERHANG_STEP - 1e-9).astype(int)  # 0: wholly inside
+        # In steps, 0 where wholly inside; the 1e-9 keeps float noise from adding a step.
+        past = np.ceil(past / OVERHANG_STEP - 1e-9).astype(int)
         drop = held[..., 2].min(axis=1) - floor
         fall = (drop // FALL_STEP).astype(int)
         coarse = (drop // OVERHANG_FALL_STEP).astype(int)
