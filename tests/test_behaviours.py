@@ -667,10 +667,10 @@ def test_postures_that_hold_an_object_partly_past_the_opening_rank_upright_and_t
 ):
     """No posture holds a box 24 cm long wholly over the opening. Upright and tilted
     postures then rank together, by the fall in OVERHANG_FALL_STEP steps and then by how far
-    they hold it past the opening: from an upright posture ranked first for coming first, a
-    cereal box held 12 cm past a wall toppled across the opening onto both walls (in-situ),
-    where the next carry to the basket met it (154 N); from a tilted one 3.7 cm past, it fell
-    in."""
+    they hold it past the opening. Let go from an upright posture, ranked first only for
+    being upright, a cereal box held 12 cm past a wall toppled across the opening onto both
+    walls (in-situ), where the next carry to the basket met it (154 N); let go from a tilted
+    one 3.7 cm past, it fell in."""
     payload = _box_points((0.24, 0.11, 0.12))
     free = CollisionChecker(np.zeros((0, 3)))
     drops = Behaviours(robot).drop_configurations(dims.UR5_READY_Q, free, payload)
