@@ -221,10 +221,12 @@ def basket_opening() -> tuple[np.ndarray, np.ndarray]:
     return dims.BASKET_CENTER[:2] - half + 0.01, dims.BASKET_CENTER[:2] + half - 0.01
 
 
-def over_the_opening(held: np.ndarray) -> np.ndarray:
-    """Whether each point of `held` (..., 3) (m, `base`) lies over the basket's opening."""
+def past_the_opening(held: np.ndarray) -> np.ndarray:
+    """How far (m) each point of `held` (..., 3) (m, `base`) lies past the basket's opening,
+    across: 0 over it."""
     lo, hi = basket_opening()
-    return np.all((held[..., :2] >= lo) & (held[..., :2] <= hi), axis=-1)
+    xy = held[..., :2]
+    return np.maximum(np.maximum(lo - xy, xy - hi), 0.0).max(axis=-1)
 
 
 class Behaviours:
@@ -573,16 +575,14 @@ class Behaviours:
         T = tcp_pose(Q)
         pts = payload if len(payload) else np.zeros((1, 3))
         held = held_at(T, pts)  # (B, P, 3)
-        middle_in = over_the_opening(held.mean(axis=1))
+        middle_in = past_the_opening(held.mean(axis=1)) == 0
         Q, held = Q[middle_in], held[middle_in]
         # In chunks: the check's arrays grow with candidates x payload points x spheres.
         clear = np.concatenate(
             [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
             or [np.zeros(0, bool)]
         )
-        lo, hi = basket_opening()
-        xy = held[..., :2]
-        past = np.maximum(np.maximum(lo - xy, xy - hi), 0.0).max(axis=(1, 2))
+        past = past_the_opening(held).max(axis=1)
         # In steps, 0 where wholly inside; the 1e-9 keeps float noise from adding a step.
         past = np.ceil(past / OVERHANG_STEP - 1e-9).astype(int)
         drop = held[..., 2].min(axis=1) - floor
@@ -739,7 +739,7 @@ class Behaviours:
         # a protective stop). The object can only have fallen from where the hand let go.
         T = tcp_pose(self._q())
         let_go = held.at(T)
-        caution = None if over_the_opening(let_go).all() else PAST_THE_OPENING
+        caution = PAST_THE_OPENING if past_the_opening(let_go).any() else None
 
         def said(out: Outcome) -> Outcome:
             if caution is None:
