@@ -36,6 +36,7 @@ from laserpick.bench.picking import BENCH, LEVER_MAX, ScriptedOperator, lever, o
 from laserpick.bench.protocols import (
     FLOOR_TURNS,
     JEEVES_MODELS,
+    PLACE_ROOM,
     PROTOCOLS,
     UPRIGHT_TILT,
     Options,
@@ -576,6 +577,45 @@ def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) 
             assert found is not None
             gap = np.linalg.norm(cup - found[1][:2], axis=1).min()
             assert gap > reach + 0.05, f"the toy would stand {gap - reach:.3f} m from the cup"
+
+
+def test_where_the_line_of_spots_is_full_the_user_sets_down_nearest_it(tmp_path: Path) -> None:
+    """Every place of a trial goes to the line 25 cm behind a surface's front edge while it
+    has room. Where a row of cans fills that line, the user sets a TV remote down elsewhere
+    on the top, clear of every can and of the edges, as near the line as there is room;
+    before, they found no spot and the task was lost. An empty top still takes it on the
+    line."""
+    cans = "".join(
+        f"  - {{name: can{i}, model: soda_can, on: t, xy: [1.55, {y:.2f}]}}\n"
+        for i, y in enumerate(np.arange(-0.40, 0.41, 0.10))
+    )
+    scene = tmp_path / "row.yaml"
+    scene.write_text(
+        "name: row\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "surfaces:\n  - {name: t, kind: table, xy: [1.6, 0.0], size: [0.7, 1.2], height: 0.46}\n"
+        "  - {name: e, kind: table, xy: [0.0, 2.0], size: [0.7, 1.2], height: 0.46}\n"
+        f"objects:\n{cans}  - {{name: remote, model: tv_remote, on: e, xy: [0.0, 2.0]}}\n"
+    )
+    loaded = load_scene(str(scene))
+    with _operated(loaded, 0, 1, Options()) as op:
+        table = loaded.surface("t")
+        room = room_for(op, "remote")
+        cans = np.vstack(
+            [op.referee.object_points(f"can{i}", frame="world")[:, :2] for i in range(9)]
+        )
+        for _ in range(10):
+            found = free_spot(op, table, room, "remote")
+            assert found is not None, "the top has room behind and before the row"
+            local = table.to_local(found[1][:2])
+            depth = local[0] + table.size[0] / 2
+            assert abs(depth - 0.25) > 0.05, "the line is full"
+            assert np.linalg.norm(cans - found[1][:2], axis=1).min() > room
+            reach = room - PLACE_ROOM
+            assert reach + 0.03 <= depth <= table.size[0] - reach - 0.03
+        empty = free_spot(op, loaded.surface("e"), room, "remote")
+        assert empty is not None
+        depth = loaded.surface("e").to_local(empty[1][:2])[0] + 0.35
+        assert depth == pytest.approx(0.25)
 
 
 def test_a_set_down_object_is_judged_by_where_it_stands(tmp_path: Path) -> None:

@@ -109,6 +109,15 @@ PLACE_ROOM = 0.07
 #: watches the dot does; three marks on the side of a box in front of the spot were refused
 #: ("not on a flat surface") and the task was lost.
 AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), (0.05, 0.0))
+#: Where the line 25 cm behind a surface's front edge has no free spot, the user sets
+#: things down elsewhere on the top, nearest that line: these many random spots are
+#: weighed, SPOT_EDGE_ROOM (m) or more from the front and back edges and the object's
+#: footprint clear of them. Every place of a
+#: trial went to that line, so by its last tasks it was full: a plush toy found no spot on
+#: three surfaces, a TV remote none on three, though each had room behind (pick-place,
+#: seeds 200 and 1).
+SPOT_TRIES = 400
+SPOT_EDGE_ROOM = 0.12
 #: The laser-scan protocol's step between aim points (m), 002's "about 1.5 cm".
 SCAN_STEP = 0.015
 #: The models of the two-object selection trials: the `isolation` set less the tall cereal
@@ -446,19 +455,36 @@ _OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 def free_spot(
     op: ScriptedOperator, surface: Surface, room: float, held: str | None
 ) -> tuple[float, np.ndarray] | None:
-    """A spot on the top of `surface`, 25 cm behind its front edge (half its depth if that is
-    less), `room` m from every point of the objects there but `held`: (local y, world xyz).
-    A shelf's top, not its lower boards: under a board the cameras see no dot and no
+    """A spot on the top of `surface`, `room` m from every point of the objects there but
+    `held`: (local y, world xyz). First on the line 25 cm behind its front edge (half its
+    depth if that is less), where the user parks to work; where that line is full, the
+    free spot nearest it, its footprint (and SPOT_EDGE_ROOM) clear of the front and back
+    edges. A shelf's top, not its lower boards: under a board the cameras see no dot and no
     surface. None when the surface has no such spot."""
     half_w = surface.size[1] / 2 - 0.15
     level = surface.levels[-1]
-    depth = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
+    front = -surface.size[0] / 2
+    line = min(PARK_SPOT_DEPTH, surface.size[0] / 2)
     others = _standing(op, level, held)
+
+    def spot(depth: float, ly: float) -> np.ndarray | None:
+        xy = surface.to_world(np.array([front + depth, ly]))
+        return np.array([xy[0], xy[1], level]) if _free(others, xy, room) else None
+
     for _ in range(100):
         ly = float(op.rng.uniform(-half_w, half_w)) if half_w > 0 else 0.0
-        xy = surface.to_world(np.array([-surface.size[0] / 2 + depth, ly]))
-        if _free(others, xy, room):
-            return ly, np.array([xy[0], xy[1], level])
+        if (at := spot(line, ly)) is not None:
+            return ly, at
+    # Off the line, the edges are near: the whole footprint must stay on the top.
+    edge = max(SPOT_EDGE_ROOM, room - PLACE_ROOM + 0.03)
+    deepest = surface.size[0] - edge
+    if deepest < edge or half_w <= 0:
+        return None
+    depths = op.rng.uniform(edge, deepest, SPOT_TRIES)
+    across = op.rng.uniform(-half_w, half_w, SPOT_TRIES)
+    for k in np.argsort(np.abs(depths - line), kind="stable"):
+        if (at := spot(float(depths[k]), float(across[k]))) is not None:
+            return float(across[k]), at
     return None
 
 
