@@ -638,9 +638,11 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
     # the 108 cm table) shows them only its front edge.
     markable = [s for s in scene.surfaces if s.levels[-1] < dims.LASER_ORIGIN[2] - 0.05]
     dests = [s for s in markable if s.name != here] or [scene.surface(here)]
-    # A random other surface; where it has no free spot, or no way to park at one, the user
+    # A random other surface; where it has no free spot, no way to park at one, or the robot
+    # refused every mark there (held as it is, the arm would reach into the floor), the user
     # takes the next, as a person with something in hand would.
     refused = []
+    placed = None
     for dest in (dests[int(k)] for k in op.rng.permutation(len(dests))):
         spot = free_spot(op, dest, room, rec.instance)
         if spot is None:
@@ -650,17 +652,21 @@ def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, back: float =
         local_x = float(dest.to_local(spot_world[:2])[0])
         outline = op.referee.outline()  # the object in hand included
         works_at = None if dest.kind == "floor" else dest.name
-        if _park(op, scene, dest, local_x, local_y, spot_world[2], works_at, outline):
-            break
-        refused.append(f"the user could not park at {dest.name}")
-    else:
-        return rec.fail("precondition", "; ".join(refused) or "no surface to put it on")
-    aims = _aims_in_sight(op, dest, spot_world, room, rec.instance)
-    for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand still holds it
-        placed = op.place(aim)
-        rec.places += 1
+        if not _park(op, scene, dest, local_x, local_y, spot_world[2], works_at, outline):
+            refused.append(f"the user could not park at {dest.name}")
+            continue
+        aims = _aims_in_sight(op, dest, spot_world, room, rec.instance)
+        for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand holds it
+            placed = op.place(aim)
+            rec.places += 1
+            if placed.failure is None or session.state not in HOLDING_STATES:
+                break
+        assert placed is not None  # MAX_TRIES >= 1 marks
         if placed.failure is None or session.state not in HOLDING_STATES:
             break
+        refused.append(f"{dest.name}: {placed.failure.message}")
+    if placed is None:
+        return rec.fail("precondition", "; ".join(refused) or "no surface to put it on")
     if placed.failure is not None or placed.hit is None:
         failure = placed.failure or Failure("detect_laser", "the laser lit nothing")
         return rec.fail(failure.kind, failure.message)
