@@ -32,10 +32,18 @@ from laserpick.bench.operator import (
     parking_pose,
     plan_drive,
 )
-from laserpick.bench.picking import BENCH, LEVER_MAX, ScriptedOperator, lever, open_session
+from laserpick.bench.picking import (
+    BENCH,
+    LEVER_MAX,
+    Placed,
+    ScriptedOperator,
+    lever,
+    open_session,
+)
 from laserpick.bench.protocols import (
     FLOOR_TURNS,
     JEEVES_MODELS,
+    MAX_TRIES,
     PLACE_ROOM,
     PROTOCOLS,
     UPRIGHT_TILT,
@@ -58,6 +66,7 @@ from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.types import Failure
 from laserpick.robot.objects import LIBRARY
 from laserpick.robot.scenes import load_scene, scene_config
 from laserpick.transforms import (
@@ -676,6 +685,44 @@ def test_the_user_watches_the_dot_of_a_place_mark_on_a_top_just_below_the_pointe
             op.aim(spot, watched=True)
             watched += op.dot_near(spot)
     assert watched >= once + 4, (watched, once)
+
+
+def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_surface(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Held as it was picked, an object may not go down on a surface at all (a spice jar
+    held from a shelf at 14 degrees would take the wrist into the floor): the robot refuses
+    each mark there and keeps it. A person then carries it to another surface, as the
+    pick-place user now does. The refusal is staged here (the first surface's marks are
+    answered with the robot's `ik_plan` refusal, without moving); the pick, the drives and
+    the place on the second surface are real."""
+    scene = tmp_path / "two.yaml"
+    scene.write_text(
+        "name: two\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\nsurfaces:\n"
+        "  - {name: table_73, kind: table, xy: [1.65, -0.10], size: [0.7, 1.2], height: 0.73}\n"
+        "  - {name: table_31, kind: table, xy: [0.40, 2.90], yaw_deg: 90, size: [0.5, 0.9],"
+        " height: 0.31}\n"
+        "  - {name: counter, kind: counter, xy: [0.10, -2.40], yaw_deg: -90, size: [0.6, 1.2],"
+        " height: 0.87}\n"
+        "objects:\n  - {name: can, model: soda_can, on: table_73, xy: [1.42, -0.30]}\n"
+    )
+    first: list[np.ndarray] = []
+    place = ScriptedOperator.place
+
+    def refusing(op: ScriptedOperator, spot: np.ndarray) -> Placed:
+        at = op.referee.to_world(spot)  # parked at each surface alike, `base` aims repeat
+        if not first:
+            first.append(at)
+        if np.linalg.norm(at[:2] - first[0][:2]) < 0.3:  # the first surface's aims
+            return Placed(Failure("ik_plan", "refused here"), None)
+        return place(op, spot)
+
+    monkeypatch.setattr(ScriptedOperator, "place", refusing)
+    (rec,) = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    assert rec.success, (rec.message, rec.places, rec.surface)
+    assert rec.places == MAX_TRIES + 1, "three refused marks, then one on the other surface"
+    here, to = rec.surface.split(" -> ")
+    assert here == "table_73" and to in ("table_31", "counter")
 
 
 def test_a_pick_place_task_is_tried_again_while_its_object_stands_where_it_stood(
