@@ -112,10 +112,9 @@ AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), 
 #: Where the line 25 cm behind a surface's front edge has no free spot, the user sets
 #: things down elsewhere on the top, nearest that line: these many random spots are
 #: weighed, SPOT_EDGE_ROOM (m) or more from the front and back edges and the object's
-#: footprint clear of them. Every place of a
-#: trial went to that line, so by its last tasks it was full: a plush toy found no spot on
-#: three surfaces, a TV remote none on three, though each had room behind (pick-place,
-#: seeds 200 and 1).
+#: footprint clear of them. Every place of a trial went to that line, so by its last tasks
+#: it was full: a plush toy found no spot on three surfaces, a TV remote none on three,
+#: though each had room behind (pick-place, seeds 200 and 1).
 SPOT_TRIES = 400
 SPOT_EDGE_ROOM = 0.12
 #: The laser-scan protocol's step between aim points (m), 002's "about 1.5 cm".
@@ -478,10 +477,10 @@ def free_spot(
     # Off the line, the edges are near: the whole footprint must stay on the top.
     edge = max(SPOT_EDGE_ROOM, room - PLACE_ROOM + 0.03)
     deepest = surface.size[0] - edge
-    if deepest < edge or half_w <= 0:
+    if deepest < edge:
         return None
     depths = op.rng.uniform(edge, deepest, SPOT_TRIES)
-    across = op.rng.uniform(-half_w, half_w, SPOT_TRIES)
+    across = op.rng.uniform(-half_w, half_w, SPOT_TRIES) if half_w > 0 else np.zeros(SPOT_TRIES)
     for k in np.argsort(np.abs(depths - line), kind="stable"):
         if (at := spot(float(depths[k]), float(across[k]))) is not None:
             return float(across[k]), at
