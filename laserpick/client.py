@@ -16,17 +16,19 @@ and heartbeats on it every `heartbeat_s` (the server halts motion after 0.5 s of
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import json
 import logging
 import threading
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
 from typing import Any
 
 import requests
+from websockets.asyncio.client import connect
 from websockets.exceptions import WebSocketException
-from websockets.sync.client import ClientConnection, connect
 
 API = "/api/v1"
 log = logging.getLogger(__name__)
@@ -74,7 +76,6 @@ class Client:
         self.frames = 0  #: state frames received
         self.gaps = 0  #: frames the server dropped for us (gaps in `seq`)
         self._last_seq = 0
-        self._ws: ClientConnection | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -140,35 +141,51 @@ class Client:
         self.release()
 
     def _start_events(self) -> None:
+        """Open the events websocket on a thread of its own; raise here if it cannot open."""
         self._stop.clear()
-        ws_url = "ws" + self.url[len("http") :] + f"{API}/events"
-        self._ws = connect(ws_url, open_timeout=self.timeout, max_size=2**22)
-        self._thread = threading.Thread(target=self._pump, name="laserpick-client", daemon=True)
+        opened: Future[None] = Future()
+        self._thread = threading.Thread(
+            target=asyncio.run, args=(self._events(opened),), name="laserpick-client", daemon=True
+        )
         self._thread.start()
+        try:
+            opened.result()
+        except BaseException:
+            self._thread.join(timeout=2.0)
+            self._thread = None
+            raise
 
     def _stop_events(self) -> None:
         self._stop.set()
-        if self._ws is not None:
-            self._ws.close()
         if self._thread is not None:
             self._thread.join(timeout=2.0)
-        self._ws = self._thread = None
+        self._thread = None
 
-    def _pump(self) -> None:
-        ws = self._ws
-        assert ws is not None
+    async def _events(self, opened: Future[None]) -> None:
+        """Heartbeat and receive on one event loop. (One thread must own the socket: the
+        sync client reads on a thread of its own while the caller writes, which an https
+        URL's TLS session does not allow; through nginx it lost handshakes and frames.)"""
+        ws_url = "ws" + self.url[len("http") :] + f"{API}/events"
+        try:
+            ws = await connect(ws_url, open_timeout=self.timeout, close_timeout=1.0, max_size=2**22)
+        except BaseException as exc:
+            opened.set_exception(exc)
+            return
+        opened.set_result(None)
         next_beat = 0.0
         try:
-            while not self._stop.is_set():
-                now = time.monotonic()
-                if now >= next_beat and self.token is not None:
-                    ws.send(json.dumps({"type": "heartbeat", "token": self.token}))
-                    next_beat = now + self.heartbeat_s
-                try:
-                    text = ws.recv(timeout=max(0.0, next_beat - time.monotonic()))
-                except TimeoutError:
-                    continue
-                self._on_message(json.loads(text))
+            async with ws:
+                while not self._stop.is_set():
+                    now = time.monotonic()
+                    if now >= next_beat:
+                        if self.token is not None:
+                            await ws.send(json.dumps({"type": "heartbeat", "token": self.token}))
+                        next_beat = now + self.heartbeat_s
+                    try:  # waking each heartbeat also notices `_stop` within `heartbeat_s`
+                        text = await asyncio.wait_for(ws.recv(), next_beat - time.monotonic())
+                    except TimeoutError:
+                        continue
+                    self._on_message(json.loads(text))
         except (WebSocketException, OSError):
             pass  # the server went away; requests will say so
         except Exception:  # without heartbeats the server halts motion: say why
