@@ -35,6 +35,7 @@ from laserpick.bench.operator import (
 from laserpick.bench.picking import (
     BENCH,
     LEVER_MAX,
+    Attempt,
     Placed,
     ScriptedOperator,
     lever,
@@ -42,13 +43,16 @@ from laserpick.bench.picking import (
 )
 from laserpick.bench.protocols import (
     FLOOR_TURNS,
+    IN_VIEW_ACROSS,
     JEEVES_MODELS,
     MAX_TRIES,
     PLACE_ROOM,
     PROTOCOLS,
+    RETRY_BACK,
     UPRIGHT_TILT,
     Options,
     _aims_in_sight,
+    _next_try,
     _operated,
     _still_there,
     coin_flip_kitchen,
@@ -66,6 +70,7 @@ from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.grasping import UNSEEN_WAYS
 from laserpick.pipeline.types import Failure
 from laserpick.robot.objects import LIBRARY
 from laserpick.robot.scenes import load_scene, scene_config
@@ -723,6 +728,30 @@ def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_su
     assert rec.places == MAX_TRIES + 1, "three refused marks, then one on the other surface"
     here, to = rec.surface.split(" -> ")
     assert here == "table_73" and to in ("table_31", "counter")
+
+
+def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer_their_middle():
+    """After an ik_plan failure the user parks farther back, except after the robot says its
+    only ways passed where the cameras could not see: then first with the object nearer the
+    middle of their view, to the arm's left (the 108 cm table's juice bottle). Other
+    failures change nothing; the parking pose puts the spot that far to the arm's left."""
+
+    def failed(kind: str, message: str) -> Attempt:
+        return Attempt(0, 1, "o", "m", None, "manual", "gpd").fail(kind, message)
+
+    unseen = failed("ik_plan", f"None of the 2 grasps could be planned (No way{UNSEEN_WAYS})")
+    blocked = failed("ik_plan", "The arm cannot take any of 9 grasps (every posture collides).")
+    assert _next_try(unseen, 0.0, 0.0) == (0.0, IN_VIEW_ACROSS)
+    assert _next_try(unseen, 0.0, IN_VIEW_ACROSS) == (RETRY_BACK, IN_VIEW_ACROSS)
+    assert _next_try(blocked, 0.0, 0.0) == (RETRY_BACK, 0.0)
+    assert _next_try(failed("execute", "slipped" + UNSEEN_WAYS), 0.1, 0.0) == (0.1, 0.0)
+
+    table = load_scene("kitchen", seed=1).surface("high_table")
+    spot = np.array([*table.xy, 0.0]) + [-table.size[0] / 2 + 0.25, 0.0, 0.0]  # yaw 0
+    for across in (0.0, IN_VIEW_ACROSS):
+        x, y, yaw = parking_pose(table, 0.0, table.levels[0], across=across)
+        in_base = invert(planar_pose(x, y, yaw)) @ np.append(spot, 1.0)
+        assert in_base[1] == pytest.approx(dims.ARM_MOUNT_POS[1] + across, abs=1e-9)
 
 
 def test_a_pick_place_task_is_tried_again_while_its_object_stands_where_it_stood(
