@@ -732,19 +732,22 @@ def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_su
 
 def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer_their_middle():
     """After an ik_plan failure the user parks farther back, except after the robot says its
-    only ways passed where the cameras could not see: then first with the object nearer the
-    middle of their view, to the arm's left (the 108 cm table's juice bottle). Other
-    failures change nothing; the parking pose puts the spot that far to the arm's left."""
+    only ways passed where the cameras could not see an object on a table: then first with
+    the object nearer the middle of their view, to the arm's left (the 108 cm table's juice
+    bottle). At a shelf they back off, for its board. Other failures change nothing; the
+    parking pose puts the spot that far to the arm's left."""
 
     def failed(kind: str, message: str) -> Attempt:
         return Attempt(0, 1, "o", "m", None, "manual", "gpd").fail(kind, message)
 
     unseen = failed("ik_plan", f"None of the 2 grasps could be planned (No way{UNSEEN_WAYS})")
     blocked = failed("ik_plan", "The arm cannot take any of 9 grasps (every posture collides).")
-    assert _next_try(unseen, 0.0, 0.0) == (0.0, IN_VIEW_ACROSS)
-    assert _next_try(unseen, 0.0, IN_VIEW_ACROSS) == (RETRY_BACK, IN_VIEW_ACROSS)
-    assert _next_try(blocked, 0.0, 0.0) == (RETRY_BACK, 0.0)
-    assert _next_try(failed("execute", "slipped" + UNSEEN_WAYS), 0.1, 0.0) == (0.1, 0.0)
+    assert _next_try(unseen, 0.0, 0.0, shelf=False) == (0.0, IN_VIEW_ACROSS)
+    assert _next_try(unseen, 0.0, IN_VIEW_ACROSS, shelf=False) == (RETRY_BACK, IN_VIEW_ACROSS)
+    assert _next_try(unseen, 0.0, 0.0, shelf=True) == (RETRY_BACK, 0.0)  # room under a board
+    assert _next_try(blocked, 0.0, 0.0, shelf=False) == (RETRY_BACK, 0.0)
+    kept = _next_try(failed("execute", "slipped" + UNSEEN_WAYS), 0.1, 0.0, shelf=False)
+    assert kept == (0.1, 0.0)
 
     table = load_scene("kitchen", seed=1).surface("high_table")
     spot = np.array([*table.xy, 0.0]) + [-table.size[0] / 2 + 0.25, 0.0, 0.0]  # yaw 0
