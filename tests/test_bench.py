@@ -730,6 +730,35 @@ def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_su
     assert here == "table_73" and to in ("table_31", "counter")
 
 
+def test_an_object_a_lost_task_leaves_in_the_hand_is_taken_away_not_dropped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A task lost with the object still in the hand (every place mark refused) ends with the
+    helper taking the object away, as from the basket: let go where the scooter stands, it
+    would lie on the floor in the way of the next drive. The refusals are staged (answered
+    without moving); the pick is real."""
+    scene = tmp_path / "one.yaml"
+    scene.write_text(
+        "name: one\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\nsurfaces:\n"
+        "  - {name: table_73, kind: table, xy: [1.65, -0.10], size: [0.7, 1.2], height: 0.73}\n"
+        "objects:\n  - {name: can, model: soda_can, on: table_73, xy: [1.42, -0.30]}\n"
+    )
+    monkeypatch.setattr(
+        ScriptedOperator, "place", lambda op, spot: Placed(Failure("ik_plan", "refused"), None)
+    )
+    after: list[np.ndarray] = []
+    tidy = ScriptedOperator.tidy
+
+    def tidy_and_look(op: ScriptedOperator) -> None:
+        tidy(op)
+        after.append(op.referee.position("can"))
+
+    monkeypatch.setattr(ScriptedOperator, "tidy", tidy_and_look)
+    (rec,) = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    assert rec.grasped and not rec.success and rec.places == MAX_TRIES, rec.message
+    assert np.linalg.norm(after[0][:2]) > 3.0, f"the can was left at {after[0]}"
+
+
 def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer_their_middle():
     """After an ik_plan failure the user parks farther back, except after the robot says its
     only ways passed where the cameras could not see an object on a table: then first with

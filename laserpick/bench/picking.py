@@ -371,13 +371,16 @@ class ScriptedOperator:
             if self.referee.in_basket(name):
                 self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
-            held = s.behaviours.held
+            # What the hand holds is found before it opens: in the second the gripper takes,
+            # a held object falls clear of the fingers, and was left lying where the scooter
+            # stood (seed 100's pill bottle, in front of the 73 cm table, where the user then
+            # could not park for the mug).
+            held = s.behaviours.held is not None
+            in_hand = [n for n in self.referee.instances() if held and self.referee.near_hand(n)]
             robot.gripper(False)
             robot.sleep(1.0)
-            if held is not None:
-                for name in self.referee.instances():
-                    if self.referee.near_hand(name):
-                        self.referee.take_out(name)
+            for name in in_hand:
+                self.referee.take_out(name)
         if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
             # By hand, as the experimenter would: a stow from here has no cloud to plan
             # around (the session, which had one, did not get the arm home), and one put the
