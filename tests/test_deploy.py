@@ -15,7 +15,9 @@ Through nginx, over HTTPS verified against that certificate:
    (no proxy buffering), with a heartbeat sent along the way;
 4. `/viser/` serves viser's client page (byte for byte what viser serves directly), and
    viser's websocket upgrades with its `viser-v<version>` subprotocol at `/viser` (where
-   viser's client connects from a page at /viser/) and at `/viser/`, and delivers messages.
+   viser's client connects from a page at /viser/) and at `/viser/`, and delivers messages;
+5. `laserpick.client.Client` holds control over https, its heartbeats keeping the lease,
+   and hears every state frame.
 """
 
 from __future__ import annotations
