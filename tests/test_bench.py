@@ -766,19 +766,22 @@ def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer
     bottle). At a shelf they back off, for its board. Other failures change nothing; the
     parking pose puts the spot that far to the arm's left."""
 
-    def failed(kind: str, message: str) -> Attempt:
-        return Attempt(0, 1, "o", "m", None, "manual", "gpd").fail(kind, message)
+    kitchen = load_scene("kitchen", seed=1)
+
+    def failed(kind: str, message: str, instance: str = "juice_bottle") -> Attempt:
+        return Attempt(0, 1, instance, "m", None, "manual", "gpd").fail(kind, message)
 
     unseen = failed("ik_plan", f"None of the 2 grasps could be planned (No way{UNSEEN_WAYS})")
     blocked = failed("ik_plan", "The arm cannot take any of 9 grasps (every posture collides).")
-    assert _next_try(unseen, 0.0, 0.0, shelf=False) == (0.0, IN_VIEW_ACROSS)
-    assert _next_try(unseen, 0.0, IN_VIEW_ACROSS, shelf=False) == (RETRY_BACK, IN_VIEW_ACROSS)
-    assert _next_try(unseen, 0.0, 0.0, shelf=True) == (RETRY_BACK, 0.0)  # room under a board
-    assert _next_try(blocked, 0.0, 0.0, shelf=False) == (RETRY_BACK, 0.0)
-    kept = _next_try(failed("execute", "slipped" + UNSEEN_WAYS), 0.1, 0.0, shelf=False)
+    on_shelf = failed("ik_plan", unseen.message, "cereal_box")  # room under a board
+    assert _next_try(unseen, 0.0, 0.0, kitchen) == (0.0, IN_VIEW_ACROSS)
+    assert _next_try(unseen, 0.0, IN_VIEW_ACROSS, kitchen) == (RETRY_BACK, IN_VIEW_ACROSS)
+    assert _next_try(on_shelf, 0.0, 0.0, kitchen) == (RETRY_BACK, 0.0)
+    assert _next_try(blocked, 0.0, 0.0, kitchen) == (RETRY_BACK, 0.0)
+    kept = _next_try(failed("execute", "slipped" + UNSEEN_WAYS), 0.1, 0.0, kitchen)
     assert kept == (0.1, 0.0)
 
-    table = load_scene("kitchen", seed=1).surface("high_table")
+    table = kitchen.surface("high_table")
     spot = np.array([*table.xy, 0.0]) + [-table.size[0] / 2 + 0.25, 0.0, 0.0]  # yaw 0
     for across in (0.0, IN_VIEW_ACROSS):
         x, y, yaw = parking_pose(table, 0.0, table.levels[0], across=across)

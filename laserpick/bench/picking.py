@@ -375,8 +375,11 @@ class ScriptedOperator:
             # a held object falls clear of the fingers, and was left lying where the scooter
             # stood (seed 100's pill bottle, in front of the 73 cm table, where the user then
             # could not park for the mug).
-            held = s.behaviours.held is not None
-            in_hand = [n for n in self.referee.instances() if held and self.referee.near_hand(n)]
+            in_hand = (
+                [n for n in self.referee.instances() if self.referee.near_hand(n)]
+                if s.behaviours.held is not None
+                else []
+            )
             robot.gripper(False)
             robot.sleep(1.0)
             for name in in_hand:

@@ -370,22 +370,18 @@ def _go_to_object(
     return _park(op, scene, surface, x, y, level, works_at, back=back, across=across)
 
 
-def _next_try(rec: Attempt, back: float, across: float, shelf: bool) -> tuple[float, float]:
+def _next_try(rec: Attempt, back: float, across: float, scene: Scene) -> tuple[float, float]:
     """Where the user parks for the next try after `rec` (back, across: m, as in
-    `_go_to_object`; shelf: whether the object stands on a shelf): where the arm could not
-    take the object, farther back (RETRY_BACK), or, where it stands on a table or a counter
-    and the arm said that only unseen space kept it from the object, first with it nearer
-    the middle of the cameras' view (IN_VIEW_ACROSS)."""
+    `_go_to_object`): where the arm could not take the object, farther back (RETRY_BACK),
+    or, where it stands on a table or a counter (not a shelf, as `scene` placed it) and the
+    arm said that only unseen space kept it from the object, first with it nearer the
+    middle of the cameras' view (IN_VIEW_ACROSS)."""
     if rec.failure != "ik_plan":
         return back, across
+    shelf = scene.surface(scene.placement(rec.instance).surface).kind == "shelf"
     if not shelf and UNSEEN_WAYS in (rec.message or "") and across == 0.0:
         return back, IN_VIEW_ACROSS
     return back + RETRY_BACK, across
-
-
-def _on_shelf(scene: Scene, instance: str) -> bool:
-    """Whether the object stands on a shelf (where it stood when the scene was built)."""
-    return scene.surface(scene.placement(instance).surface).kind == "shelf"
 
 
 def _park(
@@ -448,7 +444,7 @@ def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
                 if rec.success or not _still_there(op, name, stood):
                     break
                 if rec.failure == "ik_plan":
-                    back, across = _next_try(rec, back, across, _on_shelf(scene, name))
+                    back, across = _next_try(rec, back, across, scene)
                     parked = _go_to_object(op, scene, name, back, across)
     return out
 
@@ -591,7 +587,7 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
                 op.tidy()
                 if rec.success or rec.message == NO_PARKING or not _still_there(op, name, stood):
                     break
-                back, across = _next_try(rec, back, across, _on_shelf(scene, name))
+                back, across = _next_try(rec, back, across, scene)
     return out
 
 
