@@ -797,13 +797,7 @@ class Behaviours:
             return Outcome(found)
         q_above, down, T_above = found
         self.progress("Carrying the object to the place mark.")
-        out = self.go_to(
-            q_above,
-            checker,
-            "carrying to the place",
-            via=(self._holding_pose(dims.UR5_HIGH_READY_Q, checker, held.points_tcp),),
-            payload=held.points_tcp,
-        )
+        out = self._carry_to(q_above, checker, spot, held)
         if not out.ok:
             return out
         lost = self._lost_on_the_way("the place")
@@ -876,6 +870,33 @@ class Behaviours:
             return Outcome(failure, held.grasp, spot=spot)
         self.progress("Placed.")
         return Outcome(None, held.grasp, spot=spot, standing=standing)
+
+    def _carry_to(
+        self, q_above: np.ndarray, checker: CollisionChecker, spot: np.ndarray, held: Held
+    ) -> Outcome:
+        """Carry what the hand holds to q_above (6,) rad, over the place `spot` (m, `base`),
+        around `checker`, first also around a wall under the spot's surface's seen front
+        (`surface_front`), then without it. A plush toy held by its head hangs 11 cm below
+        the hand: carried up to the 87 cm counter around what the cameras saw, it was
+        swept through the counter's unseen front 3 cm under its top (19 N), turned 27° in
+        the pads, and was set down on its side."""
+        s = self.settings.motion
+        front = surface_front(checker.points, float(spot[2]), SURFACE_BAND)
+        front = front[obstacle_mask(front, voxel=0.0)]
+        walled = CollisionChecker(
+            np.vstack([checker.points, front]), margin=s.clearance, filtered=True
+        )
+        for around in (walled, checker) if len(front) else (checker,):  # the floor has none
+            out = self.go_to(
+                q_above,
+                around,
+                "carrying to the place",
+                via=(self._holding_pose(dims.UR5_HIGH_READY_Q, around, held.points_tcp),),
+                payload=held.points_tcp,
+            )
+            if out.failure is None or out.failure.kind != "ik_plan":
+                break
+        return out
 
     def _leave_placed(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
         """Take the open hand off what it has just set down: drawn back along its approach
