@@ -97,6 +97,14 @@ SUPPORT_SCATTER = 0.01
 #: hand, and at one turn it comes within the margin of the upper arm where at another it
 #: hangs clear (a banana held 8 cm off its middle could be neither tucked in nor raised).
 HOLD_TURNS = (0.0, np.pi, np.pi / 2, -np.pi / 2)
+#: Which way (unit vector, `base` xy) a refused place mark should move, by the words the
+#: refusal ends with (`crowded_message`).
+MARK_MOVES = {
+    "farther left": (0.0, 1.0),
+    "farther right": (0.0, -1.0),
+    "nearer you": (-1.0, 0.0),
+    "farther from you": (1.0, 0.0),
+}
 #: Turns (rad) about the vertical tried, in order, when the object cannot be set down as held.
 PLACE_YAWS = tuple(np.radians([0, 30, -30, 60, -60, 90, -90, 135, -135, 180]))
 #: How far (rad) the arm may be from a trajectory's start when it is sent, and how long (s)
@@ -162,6 +170,26 @@ class Held:
     def at(self, T_tcp: np.ndarray) -> np.ndarray:
         """The object's points (m, `base`) with the TCP at pose T_tcp (4, 4), `base`."""
         return self.points_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
+
+
+def crowded_message(points: np.ndarray, spot: np.ndarray) -> str:
+    """What the user hears when every way down to a place `spot` (m, `base`) comes too close
+    to something: on which side of the spot the `points` (N, 3; m, `base`) it came too
+    close to lie, and which way a mark should move (`MARK_MOVES`), as the user sees it from
+    the seat (`base` +x ahead, +y left). A pill bottle held level from a shelf's edge goes
+    down with the wrist 22 cm to the right of it, low: beside a juice bottle set down there
+    before, twelve marks on four surfaces were refused with "too close to something there",
+    each about where the user had marked before."""
+    if len(points) == 0:
+        return "The arm would come down too close to something there."
+    dx, dy = np.mean(points[:, :2], axis=0) - spot[:2]
+    if abs(dy) >= abs(dx):
+        where, move = (
+            ("to the left of", "farther right") if dy > 0 else ("to the right of", "farther left")
+        )
+    else:
+        where, move = ("beyond", "nearer you") if dx > 0 else ("in front of", "farther from you")
+    return f"The arm would come down too close to something {where} that spot: mark one {move}."
 
 
 @functools.cache
@@ -949,8 +977,9 @@ class Behaviours:
         s = self.settings.motion
         reached = False
         #: What the arm would come too near on a way down: the floor, the surface, or other
-        #: things (a keep-out box, points of the cloud).
+        #: things (a keep-out box, points of the cloud), and those points.
         crowded: set[str] = set()
+        crowding = [np.zeros((0, 3))]
         if spot[2] < SURFACE_BAND:
             # On the floor, the floor is the support: held level from the side 8 cm above
             # it, a pill bottle would go down with the wrist's spheres 8 mm over the floor,
@@ -988,6 +1017,8 @@ class Behaviours:
                     k = int(np.argmin(near & into))  # the first posture that fails
                     hits = around.what_hits(to_rest[k], hand=False) if not near[k] else []
                     crowded.update(["floor"] if "floor" in hits else hits or ["surface"])
+                    if "cloud" in hits:
+                        crowding.append(around.points_near(to_rest[k], hand=False))
                     continue
                 return q_above, down, T_above
         if not reached:
@@ -1003,7 +1034,7 @@ class Behaviours:
                 f"Held as it is, the arm would reach into {into_what} to set it down there.",
             )
         if crowded:
-            return Failure("ik_plan", "The arm would come down too close to something there.")
+            return Failure("ik_plan", crowded_message(np.vstack(crowding), spot))
         return Failure("ik_plan", "The arm cannot lower the object there.")
 
     @staticmethod

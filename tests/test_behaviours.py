@@ -15,6 +15,7 @@ import pytest
 from laserpick.behaviours import (
     DROP_TRIES,
     FALL_STEP,
+    MARK_MOVES,
     OVERHANG_FALL_STEP,
     OVERHANG_STEP,
     PLACE_YAWS,
@@ -23,6 +24,7 @@ from laserpick.behaviours import (
     Held,
     Outcome,
     basket_opening,
+    crowded_message,
     drop_candidates,
     turned_hand_xy,
 )
@@ -1019,3 +1021,23 @@ def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_int
             assert not support.clearance_ok(rest, hand=False).all()  # within the margin
             near = support.floor_as_support()
             assert near.clearance_ok(rest, hand=False, margin=0.0).all()
+
+
+def test_a_crowded_place_says_on_which_side_and_which_way_to_move_the_mark():
+    """Refused for coming too close to something, the user hears where it lies from the
+    seat (`base` +x ahead, +y left) and which way to move the mark; the way is one the
+    scripted user understands (`MARK_MOVES`)."""
+    spot = np.array([1.6, -0.3, 0.87])
+    cases = {
+        (0.0, -0.22): ("to the right of", (0.0, 1.0)),  # the level hand's wrist, beside it
+        (0.05, 0.20): ("to the left of", (0.0, -1.0)),
+        (0.20, 0.05): ("beyond", (-1.0, 0.0)),
+        (-0.20, -0.05): ("in front of", (1.0, 0.0)),
+    }
+    for (dx, dy), (where, way) in cases.items():
+        points = spot + np.array([[dx, dy, 0.06], [dx + 0.01, dy - 0.01, 0.05]])
+        message = crowded_message(points, spot)
+        assert f"something {where} that spot" in message, message
+        (move,) = [k for k in MARK_MOVES if message.rstrip(".").endswith(k)]
+        assert MARK_MOVES[move] == way
+    assert crowded_message(np.zeros((0, 3)), spot).endswith("there.")

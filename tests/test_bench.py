@@ -45,12 +45,14 @@ from laserpick.bench.protocols import (
     FLOOR_TURNS,
     IN_VIEW_ACROSS,
     JEEVES_MODELS,
+    MARK_STEP,
     MAX_TRIES,
     PLACE_ROOM,
     PROTOCOLS,
     RETRY_BACK,
     UPRIGHT_TILT,
     Options,
+    _aim_as_told,
     _aims_in_sight,
     _next_try,
     _operated,
@@ -563,6 +565,21 @@ def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
         first, second, *_ = itertools.islice(aims, 3)
         assert np.allclose(first, op.referee.to_base(in_sight))
         assert 0.04 < np.linalg.norm(second - first) < 0.06  # 5 cm across, still on the top
+
+        # Where the robot said which way to move a refused mark, they move it that far that
+        # way, while the spot stays on the top and clear of the box; else as before.
+        def told(aim: np.ndarray, way: str) -> np.ndarray | None:
+            said = f"The arm would come down too close to something there: mark one {way}."
+            return _aim_as_told(op, table, aim, said, room, None)
+
+        right = told(first, "farther right")
+        assert right is not None and np.allclose(right - first, [0.0, -MARK_STEP, 0.0])
+        assert np.linalg.norm(op.referee.to_base(op.robot.laser_hits()[0]) - right) < 0.03
+        assert told(right, "farther right") is None  # 5 cm from the top's edge
+        assert told(first, "nearer you") is not None
+        assert told(op.referee.to_base(np.array([1.55, -0.10, 0.46])), "farther left") is None
+        said = "The arm would come down too close to something there."
+        assert _aim_as_told(op, table, first, said, room, None) is None
 
 
 def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) -> None:

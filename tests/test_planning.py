@@ -132,6 +132,11 @@ def test_stowed_and_ready_poses_are_clear_and_the_checker_sees_what_it_should():
     blocked = CollisionChecker(wrist[None], voxel=0.0)
     assert not blocked.clearance_ok(dims.UR5_READY_Q)[0]
     assert blocked.what_hits(dims.UR5_READY_Q) == ["cloud"]
+    # And it is the point the posture comes too near; one 30 cm farther up is not.
+    far = wrist + [0, 0, 0.30]
+    both = CollisionChecker(np.stack([wrist, far]), voxel=0.0)
+    assert np.allclose(both.points_near(dims.UR5_READY_Q), [wrist])
+    assert len(free.points_near(dims.UR5_READY_Q)) == 0
     # The TCP through the floor, and into the rider's seat.
     for T, what in ((top_grasp(1.5, -0.3, 0.0), "floor"), (top_grasp(0.6, -0.1, 0.8), "rider")):
         Q = ik_tcp(T, dims.UR5_READY_Q)

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 import yaml
 
+from laserpick.behaviours import MARK_MOVES
 from laserpick.bench.operator import (
     PARK_SPOT_DEPTH,
     Footprint,
@@ -119,6 +120,9 @@ PLACE_ROOM = 0.07
 #: watches the dot does; three marks on the side of a box in front of the spot were refused
 #: ("not on a flat surface") and the task was lost.
 AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), (0.05, 0.0))
+#: m the user moves a place mark the way the robot said when it refused it (`_aim_as_told`):
+#: the wrist of a pill bottle's level hand came down 22 cm to the side of the object.
+MARK_STEP = 0.15
 #: Where the line 25 cm behind a surface's front edge has no free spot, the user sets
 #: things down elsewhere on the top, nearest that line: these many random spots are
 #: weighed, SPOT_EDGE_ROOM (m) or more from the front and back edges and the object's
@@ -571,6 +575,32 @@ def _aims_in_sight(
         yield last
 
 
+def _aim_as_told(
+    op: ScriptedOperator,
+    surface: Surface,
+    aim: np.ndarray,
+    refusal: str,
+    room: float,
+    held: str | None,
+) -> np.ndarray | None:
+    """Where the user marks next when the robot refused the mark `aim` (m, `base`) and said
+    which way to move it (`behaviours.MARK_MOVES`): MARK_STEP m that way, if that spot is
+    on `surface`'s top, free (`room` m from the objects there but `held`) and lit by the
+    dot; else None, and the user goes on as before (`_aims_in_sight`)."""
+    move = next((v for k, v in MARK_MOVES.items() if refusal.rstrip(".").endswith(k)), None)
+    if move is None:
+        return None
+    target = aim + MARK_STEP * np.array([*move, 0.0])
+    xy = op.referee.to_world(target)[:2]
+    half = np.asarray(surface.size[:2]) / 2
+    if np.any(np.abs(surface.to_local(xy)) > half - 0.05):
+        return None
+    if not _free(_standing(op, float(op.referee.to_world(aim)[2]), held), xy, room):
+        return None
+    op.aim(target, watched=True)
+    return target if op.dot_near(target) else None
+
+
 def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     rng = np.random.default_rng(seed)
     scene = _scene("", seed, opt) if opt.scene else coin_flip_kitchen(rng)
@@ -686,11 +716,14 @@ def _move_object(
             refused.append(f"the user could not park at {dest.name}")
             continue
         aims = _aims_in_sight(op, dest, spot_world, room, rec.instance)
-        for aim in itertools.islice(aims, MAX_TRIES):  # marks again while the hand holds it
+        aim = next(aims)
+        for tries_left in reversed(range(MAX_TRIES)):  # marks again while the hand holds it
             placed = op.place(aim)
             rec.places += 1
-            if placed.failure is None or session.state not in HOLDING_STATES:
+            if placed.failure is None or session.state not in HOLDING_STATES or not tries_left:
                 break
+            told = _aim_as_told(op, dest, aim, placed.failure.message, room, rec.instance)
+            aim = next(aims) if told is None else told
         assert placed is not None  # MAX_TRIES >= 1 marks
         if placed.failure is None or session.state not in HOLDING_STATES:
             break

@@ -548,6 +548,16 @@ class CollisionChecker:
         names += [b.name for k, b in enumerate(KEEPOUT_BOXES) if boxes[..., k].any()]
         return names + (["cloud"] if cloud.any() else [])
 
+    def points_near(self, q: np.ndarray, *, hand: bool = True) -> np.ndarray:
+        """The cloud's points (M, 3) (m, `base`) within the margin of configuration q's (6,)
+        spheres: what a refused posture comes too close to."""
+        if self.tree is None:
+            return np.zeros((0, 3))
+        keep = np.ones(len(SPHERES.radius), bool) if hand else ~SPHERES.hand
+        centres = sphere_centres(body_frames(q))[0][keep]
+        near = self.tree.query_ball_point(centres, SPHERES.radius[keep] + self.margin)
+        return self.points[np.unique(np.concatenate([np.asarray(i, int) for i in near]))]
+
     def segment_ok(
         self, qa: np.ndarray, qb: np.ndarray, *, step: float = 0.03, **kw: object
     ) -> bool:
