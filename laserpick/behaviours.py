@@ -177,7 +177,7 @@ def crowded_message(points: np.ndarray, spot: np.ndarray) -> str:
     to something: on which side of the spot the `points` (N, 3; m, `base`) it came too
     close to lie, and which way a mark should move (`MARK_MOVES`), as the user sees it from
     the seat (`base` +x ahead, +y left). A pill bottle held level from a shelf's edge goes
-    down with the wrist 22 cm to the right of it, low: beside a juice bottle set down there
+    down with the wrist 22 cm to the right of it, low: beside what had been set down there
     before, twelve marks on four surfaces were refused with "too close to something there",
     each about where the user had marked before."""
     if len(points) == 0:
@@ -906,15 +906,16 @@ class Behaviours:
         around `checker`, first also around a wall under the spot's surface's seen front
         (`surface_front`), then without it. A plush toy held by its head hangs 11 cm below
         the hand: carried up to the 87 cm counter around what the cameras saw, it was
-        swept through the counter's unseen front 3 cm under its top (19 N), turned 27° in
-        the pads, and was set down on its side."""
+        swept through the counter's unseen front up to 3 cm under its top (19 N), turned
+        27° in the pads, and was set down on its side."""
         s = self.settings.motion
         front = surface_front(checker.points, float(spot[2]), SURFACE_BAND)
         front = front[obstacle_mask(front, voxel=0.0)]
-        walled = CollisionChecker(
-            np.vstack([checker.points, front]), margin=s.clearance, filtered=True
-        )
-        for around in (walled, checker) if len(front) else (checker,):  # the floor has none
+        tries = [checker]
+        if len(front):  # the floor has none
+            points = np.vstack([checker.points, front])
+            tries.insert(0, CollisionChecker(points, margin=s.clearance, filtered=True))
+        for around in tries:
             out = self.go_to(
                 q_above,
                 around,
