@@ -172,6 +172,14 @@ class Held:
         return self.points_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
 
 
+def front_wall(points: np.ndarray, height: float) -> np.ndarray:
+    """The points (m, `base`) of a wall under the seen front of the surface at `height` (m)
+    in the cloud `points` (N, 3; `base`), as a checker takes them (`surface_front`,
+    `obstacle_mask`): none for the floor."""
+    front = surface_front(points, height, SURFACE_BAND)
+    return front[obstacle_mask(front, voxel=0.0)]
+
+
 def crowded_message(points: np.ndarray, spot: np.ndarray) -> str:
     """What the user hears when every way down to a place `spot` (m, `base`) comes too close
     to something: on which side of the spot the `points` (N, 3; m, `base`) it came too
@@ -878,12 +886,8 @@ class Behaviours:
             return Outcome(failure, held.grasp, spot=spot)
         # First around a wall under the surface's seen front (`surface_front`: a counter's
         # front runs out of the cameras' view before its top does), then without it.
-        front = surface_front(seen, float(spot[2]), SURFACE_BAND)
-        front = front[obstacle_mask(front, voxel=0.0)]
-        walled = CollisionChecker(
-            np.vstack([around.points, front]), margin=s.clearance, filtered=True
-        )
-        back = self.stow(walled)
+        front = front_wall(seen, float(spot[2]))
+        back = self.stow(around.with_points(front))
         if back.failure is not None and back.failure.kind == "ik_plan" and len(front):
             back = self.stow(around)
         if back.failure is not None and back.failure.kind == "ik_plan":
@@ -908,13 +912,8 @@ class Behaviours:
         the hand: carried up to the 87 cm counter around what the cameras saw, it was
         swept through the counter's unseen front up to 3 cm under its top (19 N), turned
         27° in the pads, and was set down on its side."""
-        s = self.settings.motion
-        front = surface_front(checker.points, float(spot[2]), SURFACE_BAND)
-        front = front[obstacle_mask(front, voxel=0.0)]
-        tries = [checker]
-        if len(front):  # the floor has none
-            points = np.vstack([checker.points, front])
-            tries.insert(0, CollisionChecker(points, margin=s.clearance, filtered=True))
+        front = front_wall(checker.points, float(spot[2]))
+        tries = [checker.with_points(front), checker] if len(front) else [checker]  # floor: none
         for around in tries:
             out = self.go_to(
                 q_above,

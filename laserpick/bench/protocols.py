@@ -547,6 +547,13 @@ def _free(others: np.ndarray, xy: np.ndarray, room: float) -> bool:
     return len(others) == 0 or float(np.min(np.linalg.norm(others - xy, axis=1))) > room
 
 
+def _on_top(surface: Surface, local: np.ndarray) -> bool:
+    """Whether the spot at `local` (m, the surface's own x back and y across from its middle)
+    lies on `surface`'s top, 5 cm or more inside its edges."""
+    half = np.asarray(surface.size[:2]) / 2
+    return not np.any(np.abs(local) > half - 0.05)
+
+
 def _aims_in_sight(
     op: ScriptedOperator, surface: Surface, spot: np.ndarray, room: float, held: str | None
 ) -> Iterator[np.ndarray]:
@@ -556,14 +563,13 @@ def _aims_in_sight(
     lands on it), then the last of them (the spot, where none is) for as long as asked. A
     person moves the mark on when the dot lands on something in front of the spot, and when
     the robot refuses to place there."""
-    half = np.asarray(surface.size[:2]) / 2
     local = surface.to_local(spot[:2])
     others = _standing(op, spot[2], held)
     last = None
     for dx, dy in AIM_SHIFTS:
         moved = local + (dx, dy)
         xy = surface.to_world(moved)
-        if np.any(np.abs(moved) > half - 0.05) or not _free(others, xy, room):
+        if not _on_top(surface, moved) or not _free(others, xy, room):
             continue
         target = op.referee.to_base(np.array([xy[0], xy[1], spot[2]]))
         op.aim(target, watched=True)
@@ -592,8 +598,7 @@ def _aim_as_told(
         return None
     target = aim + MARK_STEP * np.array([*move, 0.0])
     xy = op.referee.to_world(target)[:2]
-    half = np.asarray(surface.size[:2]) / 2
-    if np.any(np.abs(surface.to_local(xy)) > half - 0.05):
+    if not _on_top(surface, surface.to_local(xy)):
         return None
     if not _free(_standing(op, float(op.referee.to_world(aim)[2]), held), xy, room):
         return None

@@ -471,6 +471,18 @@ class CollisionChecker:
         out._own = _OwnSpace(np.vstack([own.centres, centres]), np.append(own.reach, reach))
         return out
 
+    def with_points(self, extra: np.ndarray) -> CollisionChecker:
+        """This checker with the points `extra` (M, 3) (m, `base`; already through
+        `obstacle_mask`) added after its own (what the cameras could not see but must be
+        there: a wall under a surface's seen front); the same margin and seen space.
+        Returned as it is when there are none."""
+        if len(extra) == 0:
+            return self
+        out = copy.copy(self)
+        out.points = np.vstack([self.points, extra])
+        out.tree = cKDTree(out.points)
+        return out
+
     def without(self, drop: np.ndarray) -> CollisionChecker:
         """This checker less its points where the mask `drop` (N,) is set (what is known to
         be no obstacle: parts of the target the segmentation left out); the same margin and
