@@ -85,6 +85,13 @@ WITHDRAW_STEEP = np.radians(30.0)
 #: shelf, reached into at 35 deg, brought the elbow into the scooter's sensor post drawn
 #: straight back, and left clear turned 15 deg; from inside the gap no tuck was found.
 WITHDRAW_TURNS = tuple(np.radians([0.0, 15.0, -15.0, 30.0, -30.0]))
+#: A place whose hand is within LEAVE_LEVEL (rad) of level, and has a clear way back, first
+#: lowers the open hand by LEAVE_DROP (m) (`Behaviours._leave_placed`): a pill bottle let go
+#: leaned on one pad, whose top edge was under its cap's 2 mm lip, and the hand drawn back
+#: along its approach, 7.6 deg up, dragged it 6 cm off its spot.
+LEAVE_LEVEL = np.radians(20.0)
+LEAVE_DROP = 0.005
+LEAVE_SETTLE = 0.3  #: s the lowered hand is given to get there
 #: Times the tuck searches for a way before it raises the object in front instead: each
 #: search is random, and from a hand just drawn out of the 69 cm shelf's gap the second found
 #: the way the first had not (the session's retreat then tucked it in, the task failed).
@@ -492,9 +499,24 @@ class Behaviours:
         *,
         level: bool = True,
     ) -> Failure | None:
-        """Draw the hand straight back along its `approach` (unit, `base`) by
-        `approach_distance` (or half that where the whole is not clear of `checker`, with
-        `payload` in the hand).
+        """Draw the hand back along `_withdrawal` (none where it finds no clear way)."""
+        path = self._withdrawal(approach, checker, payload, level=level)
+        if path is None:
+            return None
+        s = self.settings.motion
+        return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
+
+    def _withdrawal(
+        self,
+        approach: np.ndarray,
+        checker: CollisionChecker,
+        payload: np.ndarray | None = None,
+        *,
+        level: bool = True,
+    ) -> np.ndarray | None:
+        """The joint path (N, 6) that draws the hand straight back along its `approach`
+        (unit, `base`) by `approach_distance` (or half that where the whole is not clear of
+        `checker`, with `payload` in the hand); None where none is clear.
 
         level: after a lift from the side, back level, out of a shelf's gap before the arm
         swings anywhere (a swing planned from inside the 69 cm shelf found no way out, or
@@ -542,7 +564,7 @@ class Behaviours:
                 or not checker.clearance_ok(path, hand=False, margin=arm_margin).all()
             ):
                 continue
-            return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
+            return path
         return None
 
     def _gripping(self) -> bool:
@@ -932,12 +954,41 @@ class Behaviours:
         about it), else straight up to the TCP pose T_above (4, 4, `base`), the way it came
         down. Risen straight up from the side, the hand stayed about a tall box's top (a
         cereal box that had slid 3.6 cm down in the pads stood 1 cm above the fingers), and
-        no way to ready was found."""
+        no way to ready was found.
+
+        A hand within LEAVE_LEVEL of level with a clear way back is first lowered LEAVE_DROP
+        (`_lower_open_hand`), so that a pad under a lip of the object leaves it. Only then:
+        lowered first, a hand with no clear way back found one 5 mm lower, close along the
+        31 cm table's top, and from where it ended no way to ready was found, where rising
+        straight up from the cereal box it had set down found one."""
         start = tcp_pose(self._q())
-        failure = self._withdraw(start[:3, 2], checker, level=False)
-        if failure is None and np.linalg.norm(tcp_pose(self._q())[:3, 3] - start[:3, 3]) < 0.01:
-            self._rise_straight(T_above, "rising from the object")  # not drawn back
-        return failure
+        approach = start[:3, 2]
+        back = self._withdrawal(approach, checker, level=False)
+        if back is not None and abs(approach[2]) < np.sin(LEAVE_LEVEL):
+            self._lower_open_hand(start)
+            back = self._withdrawal(approach, checker, level=False)
+        if back is None:
+            self._rise_straight(T_above, "rising from the object")
+            return None
+        s = self.settings.motion
+        return self._run(timed(back, s, tcp_speed=s.approach_speed), "drawing back")
+
+    def _lower_open_hand(self, start: np.ndarray) -> None:
+        """Lower the open hand LEAVE_DROP straight down from TCP pose `start` (4, 4, `base`),
+        guarded as the place's descent: a pad whose top edge is under a lip of what it let go
+        of leaves it, rather than lifting it by it on the way out."""
+        s = self.settings.motion
+        T = start.copy()
+        T[2, 3] -= LEAVE_DROP
+        down = cartesian_line(self._q(), T, s.cartesian_step / 5)
+        if down is None:
+            return
+        lowering = timed(down, s, tcp_speed=s.approach_speed)
+        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
+        self._run(guarded, "freeing the fingers")  # a felt surface ends it: that is all
+        # The servos lag the trajectory's clock: when it ends the hand has come down 4 of
+        # the 5 mm.
+        self.robot.sleep(LEAVE_SETTLE)
 
     def _seen_now(self) -> np.ndarray:
         """What the cameras see around the arm now (m, `base`), thinned, the arm's own
