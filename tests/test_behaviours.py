@@ -15,6 +15,7 @@ import pytest
 from laserpick.behaviours import (
     DROP_TRIES,
     FALL_STEP,
+    LEAVE_DROP,
     MARK_MOVES,
     OVERHANG_FALL_STEP,
     OVERHANG_STEP,
@@ -841,31 +842,49 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
     """Drawn back off the object along the approach: from the side, straight up, the
-    fingers stayed about a tall box's top. From above, or where the way back is not clear,
-    straight up to the pose above the place, the way it came down."""
+    fingers stayed about a tall box's top. From the side, with the way back clear, the open
+    hand is first lowered LEAVE_DROP, so that a pad under a lip of the object leaves it (a
+    pill bottle's cap). From above, or where the way back is not clear, straight up to the
+    pose above the place, the way it came down; neither is lowered first."""
     b = Behaviours(robot)
+    moves: list[str] = []
+    run = b._run
+
+    def record(traj, what):
+        moves.append(what)
+        return run(traj, what)
+
+    b._run = record
     free = CollisionChecker(np.zeros((0, 3)))
     q_side, above = _hand_at(b, _side_pose(1.70, -0.30, 0.80))
+    start = tcp_pose(robot.joint_state().q)[:3, 3]
+    moves.clear()
     assert b._leave_placed(above, free) is None
-    np.testing.assert_allclose(
-        tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
-    )
+    assert moves == ["freeing the fingers", "drawing back"]
+    moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
+    np.testing.assert_allclose(moved, [-0.10, 0.0, -LEAVE_DROP], atol=0.0025)
     # Where the way back is not clear: up instead.
     _hand_at(b, _side_pose(1.70, -0.30, 0.80))
+    moves.clear()
     assert b._leave_placed(above, _post_behind(q_side)) is None
+    assert moves == ["rising from the object"]
     np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
-    _, above = _hand_at(b, _top_down(1.6, -0.3, 0.8))
+    _, above = _hand_at(b, _top_down(1.6, -0.3, 0.8))  # its approach is straight down
+    moves.clear()
     assert b._leave_placed(above, free) is None
+    assert moves == ["drawing back"]
     np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
     # From 45 deg above the side: back along the approach itself, up and back, not level
-    # (drawn back level, the fingers dragged a plush toy's head over).
+    # (drawn back level, the fingers dragged a plush toy's head over), and not lowered.
     oblique = np.eye(4)
     approach = np.array([np.sqrt(0.5), 0.0, -np.sqrt(0.5)])
     across = np.array([0.0, 1.0, 0.0])
     oblique[:3, :3] = np.column_stack([np.cross(across, approach), across, approach])
     oblique[:3, 3] = [1.6, -0.3, 0.8]
     _, above = _hand_at(b, oblique)
+    moves.clear()
     assert b._leave_placed(above, free) is None
+    assert moves == ["drawing back"]
     moved = tcp_pose(robot.joint_state().q)[:3, 3] - oblique[:3, 3]
     assert np.linalg.norm(moved) > 0.045  # 10 cm, or 5 where the whole way is not clear
     np.testing.assert_allclose(moved / np.linalg.norm(moved), -approach, atol=0.05)
