@@ -499,7 +499,7 @@ class Behaviours:
         *,
         level: bool = True,
     ) -> Failure | None:
-        """Draw the hand back along `_withdrawal` (none where it finds no clear way)."""
+        """Draw the hand back the way `_withdrawal` finds; stay where it finds none."""
         path = self._withdrawal(approach, checker, payload, level=level)
         if path is None:
             return None
