@@ -85,14 +85,15 @@ WITHDRAW_STEEP = np.radians(30.0)
 #: shelf, reached into at 35 deg, brought the elbow into the scooter's sensor post drawn
 #: straight back, and left clear turned 15 deg; from inside the gap no tuck was found.
 WITHDRAW_TURNS = tuple(np.radians([0.0, 15.0, -15.0, 30.0, -30.0]))
-#: A place whose hand is within LEAVE_LEVEL (rad) of level, with a clear way back and more
-#: than LEAVE_FELT (N) still on the pads once open, first lowers the open hand by LEAVE_DROP
-#: (m) (`Behaviours._leave_placed`): a pill bottle let go leaned on one pad, whose top edge
-#: was under its cap's 2 mm lip, and the hand drawn back along its approach, 7.6 deg up,
-#: dragged it 6 cm off its spot.
+#: A place whose hand is within LEAVE_LEVEL (rad) of level, and has a clear way back, first
+#: lowers the open hand by LEAVE_DROP (m) at LEAVE_SPEED (m/s) (`Behaviours._leave_placed`):
+#: a pill bottle let go leaned on one pad, whose top edge was under its cap's 2 mm lip, and
+#: the hand drawn back along its approach, 7.6 deg up, dragged it 6 cm off its spot. Slowly:
+#: lowered at the approach's 8 cm/s onto a spice jar's shoulder, a finger met it with 140 N
+#: before the guard stopped it.
 LEAVE_LEVEL = np.radians(20.0)
-LEAVE_FELT = 0.1
 LEAVE_DROP = 0.005
+LEAVE_SPEED = 0.02
 LEAVE_SETTLE = 0.3  #: s the lowered hand is given to get there
 #: Times the tuck searches for a way before it raises the object in front instead: each
 #: search is random, and from a hand just drawn out of the 69 cm shelf's gap the second found
@@ -958,18 +959,16 @@ class Behaviours:
         cereal box that had slid 3.6 cm down in the pads stood 1 cm above the fingers), and
         no way to ready was found.
 
-        A hand within LEAVE_LEVEL of level with a clear way back, whose pads still feel
-        the object (more than LEAVE_FELT), is first lowered LEAVE_DROP (`_lower_open_hand`),
-        so that a pad under a lip of the object leaves it. Only then: lowered first, a hand
-        with no clear way back found one 5 mm lower, close along the 31 cm table's top, and
-        from where it ended no way to ready was found, where rising straight up from the
-        cereal box it had set down found one; and open fingers free of a spice jar came
-        down on its shoulder (140 N)."""
+        A hand within LEAVE_LEVEL of level with a clear way back is first lowered
+        LEAVE_DROP (`_lower_open_hand`), so that a pad under a lip of the object leaves it.
+        (The pads feel nothing yet when the hand has opened: the bottle leans on one after.)
+        Only with a clear way back: lowered first, a hand with none found one 5 mm lower,
+        close along the 31 cm table's top, and from where it ended no way to ready was
+        found, where rising straight up from the cereal box it had set down found one."""
         start = tcp_pose(self._q())
         approach = start[:3, 2]
         back = self._withdrawal(approach, checker, level=False)
-        felt = self.robot.gripper_state().force
-        if back is not None and abs(approach[2]) < np.sin(LEAVE_LEVEL) and felt > LEAVE_FELT:
+        if back is not None and abs(approach[2]) < np.sin(LEAVE_LEVEL):
             self._lower_open_hand(start)
             back = self._withdrawal(approach, checker, level=False)
         if back is None:
@@ -981,16 +980,17 @@ class Behaviours:
     def _lower_open_hand(self, start: np.ndarray) -> None:
         """Lower the open hand LEAVE_DROP straight down from TCP pose `start` (4, 4, `base`),
         guarded as the place's descent: a pad whose top edge is under a lip of what it let go
-        of leaves it, rather than lifting it by it on the way out. A pad that comes down on
+        of leaves it, rather than lifting it by it on the way out. A hand that comes down on
         something instead (a shoulder of the object, the surface) goes back up to `start`:
-        drawn back from there pressed down, a pad dragged a spice jar's shoulder (196 N)."""
+        drawn back from where it had met a spice jar's shoulder, a finger dragged it (196
+        N, a protective stop)."""
         s = self.settings.motion
         T = start.copy()
         T[2, 3] -= LEAVE_DROP
         down = cartesian_line(self._q(), T, s.cartesian_step / 5)
         if down is None:
             return
-        lowering = timed(down, s, tcp_speed=s.approach_speed)
+        lowering = timed(down, s, tcp_speed=LEAVE_SPEED)
         guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
         met = self._run(guarded, "freeing the fingers")
         # The servos lag the trajectory's clock: when it ends the hand has come down 4 of
