@@ -16,7 +16,6 @@ from laserpick.behaviours import (
     DROP_TRIES,
     FALL_STEP,
     LEAVE_DROP,
-    LEAVE_FELT,
     MARK_MOVES,
     OVERHANG_FALL_STEP,
     OVERHANG_STEP,
@@ -843,9 +842,10 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
     """Drawn back off the object along the approach: from the side, straight up, the
-    fingers stayed about a tall box's top. From above, or where the way back is not clear,
-    straight up to the pose above the place, the way it came down. None of these is lowered
-    first: the pads feel nothing (that is for a lip resting on a pad, the test below)."""
+    fingers stayed about a tall box's top. From the side, with the way back clear, the open
+    hand is first lowered LEAVE_DROP, so that a pad under a lip of the object leaves it (a
+    pill bottle's cap). From above, or where the way back is not clear, straight up to the
+    pose above the place, the way it came down; neither is lowered first."""
     b = Behaviours(robot)
     moves: list[str] = []
     run = b._run
@@ -859,10 +859,10 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     q_side, above = _hand_at(b, _side_pose(1.70, -0.30, 0.80))
     moves.clear()
     assert b._leave_placed(above, free) is None
-    assert moves == ["drawing back"]  # the pads feel nothing: not lowered
-    np.testing.assert_allclose(
-        tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
-    )
+    assert moves == ["freeing the fingers", "drawing back"]
+    end = tcp_pose(robot.joint_state().q)[:3, 3]
+    np.testing.assert_allclose(end[:2], [1.60, -0.30], atol=0.005)
+    assert 0.80 - LEAVE_DROP - 0.001 < end[2] < 0.80 - LEAVE_DROP / 2  # the servos lag
     # Where the way back is not clear: up instead.
     _hand_at(b, _side_pose(1.70, -0.30, 0.80))
     moves.clear()
@@ -890,17 +890,14 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     np.testing.assert_allclose(moved / np.linalg.norm(moved), -approach, atol=0.05)
 
 
-def test_an_open_hand_lowers_off_a_lip_resting_on_its_pad_before_it_draws_back():
-    """A pill bottle set down from the side leaned on one open pad, whose top edge was under
-    its cap's 2 mm lip, and the hand drawn back dragged it 6 cm off its spot. Here a pad is
-    brought under the cap's lip and raised 2 mm into it, so that the lip rests on the pad:
-    the pads feel it, the hand is lowered LEAVE_DROP, then drawn back, and the bottle
-    stands where it stood. (Drawn back at once, the pad drags it.)"""
-    robot = SimRobot(load_scene(str(DATA / "pill_bottle.yaml"), seed=1), realtime=False)
+def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back():
+    """Lowered LEAVE_DROP from the side, open fingers came down on a spice jar's shoulder,
+    and drawn back from there, dragged it (196 N, a protective stop). Here the open hand
+    stands level 2 mm over a table top: lowered, it meets the table, stops, goes back up
+    to where it stood, and is drawn back from there, level."""
+    robot = SimRobot(load_scene(str(DATA / "table_top.yaml"), seed=1), realtime=False)
     try:
         robot.sim.settle(0.5)
-        name = "pill_bottle_1"
-        referee = Referee(robot)
         b = Behaviours(robot)
         moves: list[str] = []
         run = b._run
@@ -910,49 +907,34 @@ def test_an_open_hand_lowers_off_a_lip_resting_on_its_pad_before_it_draws_back()
             return run(traj, what)
 
         b._run = record
-        stood = referee.position(name)
-        cap = stood[2] + 0.07  # the cap's underside (m, `base`)
-        # The pad on the hand's +y side, 0.5 mm off the 21 mm body, under the 23 mm cap.
-        pad_y = stood[1] - 0.0215 - dims.GRIPPER_PAD_THICKNESS / 2
-        tcp_y = pad_y - dims.GRIPPER_STROKE / 2 - dims.GRIPPER_PAD_THICKNESS / 2
-        under = _side_pose(stood[0], tcp_y, cap - dims.GRIPPER_PAD_WIDTH / 2 - 0.001)
-        back = under.copy()
-        back[0, 3] -= 0.10
         top = np.mgrid[1.30:1.90:0.02, -0.65:0.35:0.02].reshape(2, -1).T
-        table = np.c_[top, np.full(len(top), TABLE_TOP)]
-        around = CollisionChecker(np.vstack([table, referee.object_points(name)]), margin=0.0)
-        q_back = next(q for q in ik_tcp(back, dims.UR5_READY_Q) if around.clearance_ok(q)[0])
-        assert b.go_to(q_back, around, "test").ok
+        table = CollisionChecker(np.c_[top, np.full(len(top), TABLE_TOP)], margin=0.0)
+        high = _side_pose(1.70, -0.30, TABLE_TOP + 0.06)
+        q = next(q for q in ik_tcp(high, dims.UR5_READY_Q) if table.clearance_ok(q)[0])
+        assert b.go_to(q, table, "test").ok
         s = b.settings.motion
-        for T in (under, under @ _lifted(0.003)):  # in under the lip, then up into it
-            path = cartesian_line(robot.joint_state().q, T, s.cartesian_step / 5)
-            assert path is not None
-            assert run(timed(path, s, tcp_speed=0.02), "test") is None
-        robot.sleep(0.5)
-        assert robot.gripper_state().force > LEAVE_FELT, "the lip rests on the pad"
-        above = under.copy()
+        # Down onto the table until it is felt, then 2 mm back up off it.
+        low = high.copy()
+        low[2, 3] = TABLE_TOP
+        path = cartesian_line(robot.joint_state().q, low, s.cartesian_step / 5)
+        down = timed(path, s, tcp_speed=0.02)
+        felt = run(Trajectory(down.times, down.q, guard_force=s.place_contact_force), "test")
+        assert felt is not None and "unexpected contact" in felt.message
+        over = tcp_pose(robot.joint_state().q)
+        over[2, 3] += 0.002
+        up = cartesian_line(robot.joint_state().q, over, s.cartesian_step / 5)
+        assert run(timed(up, s, tcp_speed=0.02), "test") is None
+        robot.sleep(0.3)
+        start = tcp_pose(robot.joint_state().q)[:3, 3]
+        above = tcp_pose(robot.joint_state().q)
         above[2, 3] += 0.10
         moves.clear()
-        start = tcp_pose(robot.joint_state().q)[:3, 3]
         assert b._leave_placed(above, CollisionChecker(np.zeros((0, 3)))) is None
-        assert moves == ["freeing the fingers", "drawing back"]
+        assert moves == ["freeing the fingers", "freeing the fingers", "drawing back"]
         moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
-        np.testing.assert_allclose(moved, [-0.10, 0.0, -LEAVE_DROP], atol=0.0025)
-        robot.sleep(0.5)
-        moved = referee.position(name) - stood
-        assert np.linalg.norm(moved[:2]) < 0.005, f"the bottle moved {moved * 100} cm"
-        up = matrix_from_quat(referee.world_quat(name)) @ [0.0, 0.0, 1.0]
-        assert np.degrees(np.arccos(np.clip(up[2], -1, 1))) < 5.0, "it stands upright"
+        np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
     finally:
         robot.close()
-
-
-def _lifted(dz: float) -> np.ndarray:
-    """A transform that, applied on the right of a `_side_pose`, raises it dz (m): the
-    pose's x axis points down."""
-    T = np.eye(4)
-    T[0, 3] = -dz
-    return T
 
 
 def _point_ahead(q_side: np.ndarray) -> CollisionChecker:
