@@ -961,7 +961,6 @@ class Behaviours:
 
         A hand within LEAVE_LEVEL of level with a clear way back is first lowered
         LEAVE_DROP (`_lower_open_hand`), so that a pad under a lip of the object leaves it.
-        (The pads feel nothing yet when the hand has opened: the bottle leans on one after.)
         Only with a clear way back: lowered first, a hand with none found one 5 mm lower,
         close along the 31 cm table's top, and from where it ended no way to ready was
         found, where rising straight up from the cereal box it had set down found one."""
