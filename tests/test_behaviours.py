@@ -840,6 +840,20 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return q, above
 
 
+def _recorded_moves(b: Behaviours) -> list[str]:
+    """The list to which each motion `b` runs from now on adds what it is ("drawing
+    back", ...)."""
+    moves: list[str] = []
+    run = b._run
+
+    def record(traj: Trajectory, what: str) -> Failure | None:
+        moves.append(what)
+        return run(traj, what)
+
+    b._run = record  # type: ignore[method-assign]
+    return moves
+
+
 def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
     """Drawn back off the object along the approach: from the side, straight up, the
     fingers stayed about a tall box's top. From the side, with the way back clear, the open
@@ -847,14 +861,7 @@ def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot
     pill bottle's cap). From above, or where the way back is not clear, straight up to the
     pose above the place, the way it came down; neither is lowered first."""
     b = Behaviours(robot)
-    moves: list[str] = []
-    run = b._run
-
-    def record(traj, what):
-        moves.append(what)
-        return run(traj, what)
-
-    b._run = record
+    moves = _recorded_moves(b)
     free = CollisionChecker(np.zeros((0, 3)))
     q_side, above = _hand_at(b, _side_pose(1.70, -0.30, 0.80))
     moves.clear()
@@ -899,14 +906,8 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
     try:
         robot.sim.settle(0.5)
         b = Behaviours(robot)
-        moves: list[str] = []
-        run = b._run
-
-        def record(traj, what):
-            moves.append(what)
-            return run(traj, what)
-
-        b._run = record
+        run = b._run  # the setup's own moves, not recorded
+        moves = _recorded_moves(b)
         top = np.mgrid[1.30:1.90:0.02, -0.65:0.35:0.02].reshape(2, -1).T
         table = CollisionChecker(np.c_[top, np.full(len(top), TABLE_TOP)], margin=0.0)
         high = _side_pose(1.70, -0.30, TABLE_TOP + 0.06)
