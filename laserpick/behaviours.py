@@ -992,11 +992,9 @@ class Behaviours:
         lowering = timed(down, s, tcp_speed=LEAVE_SPEED)
         guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
         met = self._run(guarded, "freeing the fingers")
-        # The servos lag the trajectory's clock: when it ends the hand has come down 4 of
-        # the 5 mm.
-        self.robot.sleep(LEAVE_SETTLE)
+        self.robot.sleep(LEAVE_SETTLE)  # the servos lag the trajectory's clock
         if met is not None:
-            self._rise_straight(start, "freeing the fingers")
+            self._rise_straight(start, "rising off what the fingers met")
 
     def _seen_now(self) -> np.ndarray:
         """What the cameras see around the arm now (m, `base`), thinned, the arm's own

@@ -931,7 +931,7 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         above[2, 3] += 0.10
         moves.clear()
         assert b._leave_placed(above, CollisionChecker(np.zeros((0, 3)))) is None
-        assert moves == ["freeing the fingers", "freeing the fingers", "drawing back"]
+        assert moves == ["freeing the fingers", "rising off what the fingers met", "drawing back"]
         moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
         np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
     finally:
