@@ -918,12 +918,14 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         low = high.copy()
         low[2, 3] = TABLE_TOP
         path = cartesian_line(robot.joint_state().q, low, s.cartesian_step / 5)
+        assert path is not None
         down = timed(path, s, tcp_speed=0.02)
         felt = run(Trajectory(down.times, down.q, guard_force=s.place_contact_force), "test")
         assert felt is not None and "unexpected contact" in felt.message
         over = tcp_pose(robot.joint_state().q)
         over[2, 3] += 0.002
         up = cartesian_line(robot.joint_state().q, over, s.cartesian_step / 5)
+        assert up is not None
         assert run(timed(up, s, tcp_speed=0.02), "test") is None
         robot.sleep(0.3)
         start = tcp_pose(robot.joint_state().q)[:3, 3]
