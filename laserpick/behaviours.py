@@ -504,10 +504,20 @@ class Behaviours:
     ) -> Failure | None:
         """Draw the hand back the way `_withdrawal` finds; stay where it finds none."""
         path = self._withdrawal(approach, checker, payload, level=level)
-        if path is None:
-            return None
+        return None if path is None else self._draw_back(path)
+
+    def _draw_back(self, path: np.ndarray) -> Failure | None:
+        """Run a way back (N, 6) that `_withdrawal` found, at the approach's speed."""
         s = self.settings.motion
         return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
+
+    def _descend(self, path: np.ndarray, tcp_speed: float, what: str) -> Failure | None:
+        """Run the straight way down `path` (N, 6) at `tcp_speed` (m/s), guarded: where the
+        hand or what it holds feels more than `place_contact_force`, it stops there, and the
+        failure says what it met."""
+        s = self.settings.motion
+        down = timed(path, s, tcp_speed=tcp_speed)
+        return self._run(Trajectory(down.times, down.q, guard_force=s.place_contact_force), what)
 
     def _withdrawal(
         self,
@@ -864,9 +874,7 @@ class Behaviours:
         lost = self._lost_on_the_way("the place")
         if lost is not None:
             return lost
-        lowering = timed(down, s, tcp_speed=s.approach_speed)
-        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
-        failure = self._run(guarded, "lowering the object")
+        failure = self._descend(down, s.approach_speed, "lowering the object")
         if failure is None:
             # Past the surface's height and nothing felt (EL-E 000 section 4.5): the surface
             # is not where it was seen. Keep the object, and rise to wait for another mark.
@@ -973,8 +981,7 @@ class Behaviours:
         if back is None:
             self._rise_straight(T_above, "rising from the object")
             return None
-        s = self.settings.motion
-        return self._run(timed(back, s, tcp_speed=s.approach_speed), "drawing back")
+        return self._draw_back(back)
 
     def _lower_open_hand(self, start: np.ndarray) -> None:
         """Lower the open hand LEAVE_DROP straight down from TCP pose `start` (4, 4, `base`),
@@ -989,9 +996,7 @@ class Behaviours:
         down = cartesian_line(self._q(), T, s.cartesian_step / 5)
         if down is None:
             return
-        lowering = timed(down, s, tcp_speed=LEAVE_SPEED)
-        guarded = Trajectory(lowering.times, lowering.q, guard_force=s.place_contact_force)
-        met = self._run(guarded, "freeing the fingers")
+        met = self._descend(down, LEAVE_SPEED, "freeing the fingers")
         self.robot.sleep(LEAVE_SETTLE)  # the servos lag the trajectory's clock
         if met is not None:
             self._rise_straight(start, "rising off what the fingers met")

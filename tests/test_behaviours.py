@@ -919,8 +919,7 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         low[2, 3] = TABLE_TOP
         path = cartesian_line(robot.joint_state().q, low, s.cartesian_step / 5)
         assert path is not None
-        down = timed(path, s, tcp_speed=0.02)
-        felt = run(Trajectory(down.times, down.q, guard_force=s.place_contact_force), "test")
+        felt = b._descend(path, 0.02, "test")
         assert felt is not None and "unexpected contact" in felt.message
         over = tcp_pose(robot.joint_state().q)
         over[2, 3] += 0.002
