@@ -511,13 +511,16 @@ class Behaviours:
         s = self.settings.motion
         return self._run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
 
-    def _descend(self, path: np.ndarray, tcp_speed: float, what: str) -> Failure | None:
+    def _descend(
+        self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0
+    ) -> Failure | None:
         """Run the straight way down `path` (N, 6) at `tcp_speed` (m/s), guarded: where the
-        hand or what it holds feels more than `place_contact_force`, it stops there, and the
-        failure says what it met."""
+        hand or what it holds feels more than `place_contact_force` over the `felt` (N) it
+        already bears at the start, it stops there, and the failure says what it met."""
         s = self.settings.motion
         down = timed(path, s, tcp_speed=tcp_speed)
-        return self._run(Trajectory(down.times, down.q, guard_force=s.place_contact_force), what)
+        guard = s.place_contact_force + felt
+        return self._run(Trajectory(down.times, down.q, guard_force=guard), what)
 
     def _withdrawal(
         self,
@@ -579,6 +582,14 @@ class Behaviours:
                 continue
             return path
         return None
+
+    def _pads_feel(self) -> float:
+        """What the pads press on (N): the gripper's own sensing."""
+        return self.robot.gripper_state().force
+
+    def _caught(self) -> bool:
+        """Whether the open hand's pads still press what they let go of (or anything)."""
+        return self._pads_feel() > dims.GRIPPER_HOLD_FORCE
 
     def _gripping(self) -> bool:
         state = self.robot.gripper_state()
@@ -896,7 +907,11 @@ class Behaviours:
                     " so I kept it. Mark another spot.",
                 )
             )
-        # The guard stop is the surface met: let go there, with no drop to roll from.
+        # The guard stop is the surface met: let go there, with no drop to roll from, but
+        # eased off it first (`place_ease`), not pressing the object into it.
+        eased = tcp_pose(self._q())
+        eased[2, 3] += s.place_ease
+        self._rise_straight(eased, "easing off the surface")
         self.robot.gripper(False)
         self.robot.sleep(GRIPPER_TIME)
         self.held = None
@@ -971,11 +986,15 @@ class Behaviours:
         LEAVE_DROP (`_lower_open_hand`), so that a pad under a lip of the object leaves it.
         Only with a clear way back: lowered first, a hand with none found one 5 mm lower,
         close along the 31 cm table's top, and from where it ended no way to ready was
-        found, where rising straight up from the cereal box it had set down found one."""
+        found, where rising straight up from the cereal box it had set down found one. A
+        hand whose open pads still press something (`caught`) is lowered first from any
+        approach: the finger that had dragged a mug 3.6 cm as it opened then lifted it 9 cm
+        by its handle; lowered, it came free."""
         start = tcp_pose(self._q())
         approach = start[:3, 2]
         back = self._withdrawal(approach, checker, level=False)
-        if back is not None and abs(approach[2]) < np.sin(LEAVE_LEVEL):
+        level = abs(approach[2]) < np.sin(LEAVE_LEVEL)
+        if self._caught() or (back is not None and level):
             self._lower_open_hand(start)
             back = self._withdrawal(approach, checker, level=False)
         if back is None:
@@ -996,7 +1015,7 @@ class Behaviours:
         down = cartesian_line(self._q(), T, s.cartesian_step / 5)
         if down is None:
             return
-        met = self._descend(down, LEAVE_SPEED, "freeing the fingers")
+        met = self._descend(down, LEAVE_SPEED, "freeing the fingers", felt=self._pads_feel())
         self.robot.sleep(LEAVE_SETTLE)  # the servos lag the trajectory's clock
         if met is not None:
             self._rise_straight(start, "rising off what the fingers met")

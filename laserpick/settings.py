@@ -579,6 +579,16 @@ class MotionSettings(BaseModel):
         " joint-current estimate is coarser. Ours.",
     )
 
+    place_ease: float = Field(
+        0.002,
+        ge=0,
+        description="How far (m) the hand rises, once a place's descent has felt the"
+        " surface, before it opens: the guard stops it pressing the object into the"
+        " surface. Ours: opened pressing, a mug held by its handle followed one opening"
+        " pad 3.6 cm and was lifted on it; eased 2 mm off first, the same grasp let go of"
+        " it where it stood.",
+    )
+
     @model_validator(mode="after")
     def _lifts_in_order(self) -> MotionSettings:
         """Each lift tried after a blocked one is lower, and the least still rises above the
