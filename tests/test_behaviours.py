@@ -9,6 +9,7 @@ import itertools
 import math
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -59,6 +60,7 @@ from laserpick.transforms import matrix_from_quat
 
 TABLE_TOP = 0.46  # the isolation scene's table (m)
 TABLE_FRONT = 1.30  # its front edge's x (m, `world`)
+RAIL_TOP = 0.60  # tests/data/rail.yaml
 DATA = Path(__file__).parent / "data"
 
 
@@ -340,11 +342,13 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     # go 1 cm up rolled 3 cm off its mark), and not sooner: the guard on the way down must
     # not take the grip itself for a contact.
     let_go_at: list[float] = []
+    pressed: list[float] = []
     gripper = robot.gripper
 
     def recording_gripper(close: bool) -> None:
         if not close:
             let_go_at.append(float(referee.object_points(name, frame="world")[:, 2].min()))
+            pressed.append(_borne_from_below(robot, name))
         gripper(close)
 
     robot.gripper = recording_gripper  # type: ignore[method-assign]
@@ -386,6 +390,14 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     assert len(carries) == 1, "the walled carry found its way"
     assert under_the_edge(carries[0].points) > under_the_edge(seen) + 500
     assert let_go_at and let_go_at[0] - TABLE_TOP < 0.003, f"let go {let_go_at} m up"
+    # Eased off the table before the hand opened (`place_ease`): the hand bears the object,
+    # not the table, and does not press it into it as the guard's stop left it (opened
+    # pressing, a mug held by its handle followed one pad 3.6 cm). Not eased, the table
+    # bore its whole weight here.
+    weight = 9.81 * robot.sim.call(
+        lambda m, d: m.body_subtreemass[robot.sim.info.object_bodies[name]]
+    )
+    assert pressed[0] < weight / 2, f"the table bore {pressed[0]:.1f} N of its {weight:.1f} N"
     assert out.spot is not None and abs(out.spot[2] - TABLE_TOP) < 0.01
     assert not robot.gripper_state().closed
     robot.sleep(1.0)
@@ -840,6 +852,27 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return q, above
 
 
+def _borne_from_below(robot: SimRobot, name: str) -> float:
+    """The upward force (N) on object `name` from everything but the gripper: what it
+    rests on, and anything pressing it into that."""
+    hand = set(robot.sim.info.arm_geoms.tolist())
+    body = robot.sim.info.object_bodies[name]
+
+    def up(m: mujoco.MjModel, d: mujoco.MjData) -> float:
+        total, force = 0.0, np.zeros(6)
+        for i in range(d.ncon):
+            g1, g2 = d.contact.geom[i]
+            b1, b2 = m.geom_bodyid[g1], m.geom_bodyid[g2]
+            if body not in (b1, b2) or g1 in hand or g2 in hand or b1 == b2:
+                continue
+            mujoco.mj_contactForce(m, d, i, force)
+            on_second = d.contact.frame[i].reshape(3, 3).T @ force[:3]
+            total += float(on_second[2] if b2 == body else -on_second[2])
+        return total
+
+    return float(robot.sim.call(up))
+
+
 def _recorded_moves(b: Behaviours) -> list[str]:
     """The list to which each motion `b` runs from now on adds what it is ("drawing
     back", ...)."""
@@ -935,6 +968,44 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         assert moves == ["freeing the fingers", "rising off what the fingers met", "drawing back"]
         moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
         np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
+    finally:
+        robot.close()
+
+
+def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leaves():
+    """Opened, a finger still pressed a mug it had dragged by its handle (8.9 N), and drawn
+    straight up, it lifted the mug 9 cm by the handle's top bar. Lowered first, it came
+    free. An open hand whose pads still press something is lowered first from any
+    approach, guarded over what the pads already bear. Here the open hand straddles a rail
+    from above, one pad pressed against it."""
+    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        b = Behaviours(robot)
+        moves = _recorded_moves(b)
+        free = CollisionChecker(np.zeros((0, 3)))
+        _hand_at(b, _top_down(1.60, -0.30, RAIL_TOP + 0.10))
+        s = b.settings.motion
+        straddling = _top_down(1.60, -0.30, RAIL_TOP - 0.01)
+        down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
+        assert down is not None and b._run(timed(down, s, tcp_speed=0.05), "test") is None
+        # Sideways, 12.5 mm past where a pad meets the rail: the finger gives, and presses
+        # it (less and less as it goes on giving: read at once).
+        pressed = _top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
+        across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
+        assert across is not None and b._run(timed(across, s, tcp_speed=0.02), "test") is None
+        assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+        start = tcp_pose(robot.joint_state().q)
+        above = start.copy()
+        above[2, 3] += 0.10
+        moves.clear()
+        assert b._leave_placed(above, free) is None
+        assert moves[0] == "freeing the fingers"
+        assert moves[-1] == "drawing back"
+        # Lowered LEAVE_DROP, or less where it met the rail's top, then drawn straight up.
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        np.testing.assert_allclose(end[:2], above[:2, 3], atol=0.005)
+        assert above[2, 3] - LEAVE_DROP - 0.003 < end[2] < above[2, 3] + 0.003
     finally:
         robot.close()
 
