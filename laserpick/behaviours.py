@@ -987,7 +987,7 @@ class Behaviours:
         Only with a clear way back: lowered first, a hand with none found one 5 mm lower,
         close along the 31 cm table's top, and from where it ended no way to ready was
         found, where rising straight up from the cereal box it had set down found one. A
-        hand whose open pads still press something (`caught`) is lowered first from any
+        hand whose open pads still press something (`_caught`) is lowered first from any
         approach: the finger that had dragged a mug 3.6 cm as it opened then lifted it 9 cm
         by its handle; lowered, it came free."""
         start = tcp_pose(self._q())
