@@ -857,11 +857,12 @@ class Behaviours:
         mark: the place mark (m, `base`). The mark must be on a flat surface (moved back from
         its front edge if it is too close). The object goes down with the grasp's orientation
         kept, so that it stands as it stood, its grasp height above the surface: straight
-        down from 10 cm above until the surface is felt (`place_contact_force`), then the
-        hand opens and leaves it (drawn back along its approach where that way is clear, else
-        straight up), and the arm stows around the object where it now stands. Felt more
-        than `place_above` early, it is something on the surface: the hand keeps the object
-        and rises. Nothing felt by `place_below` under the rest: the hand keeps it.
+        down from 10 cm above until the surface is felt (`place_contact_force`), eased
+        `place_ease` back up, then the hand opens and leaves it (drawn back along its
+        approach where that way is clear, else straight up), and the arm stows around the
+        object where it now stands. Felt more than `place_above` early, it is something on
+        the surface: the hand keeps the object and rises. Nothing felt by `place_below`
+        under the rest: the hand keeps it.
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:

@@ -1002,7 +1002,7 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
         assert b._leave_placed(above, free) is None
         assert moves[0] == "freeing the fingers"
         assert moves[-1] == "drawing back"
-        # Lowered LEAVE_DROP, or less where it met the rail's top, then drawn straight up.
+        # Lowered LEAVE_DROP (or less, where the guard stopped it), then drawn straight up.
         end = tcp_pose(robot.joint_state().q)[:3, 3]
         np.testing.assert_allclose(end[:2], above[:2, 3], atol=0.005)
         assert above[2, 3] - LEAVE_DROP - 0.003 < end[2] < above[2, 3] + 0.003
