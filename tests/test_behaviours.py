@@ -9,7 +9,6 @@ import itertools
 import math
 from pathlib import Path
 
-import mujoco
 import numpy as np
 import pytest
 
@@ -853,24 +852,14 @@ def _hand_at(b: Behaviours, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _borne_from_below(robot: SimRobot, name: str) -> float:
-    """The upward force (N) on object `name` from everything but the gripper: what it
-    rests on, and anything pressing it into that."""
-    hand = set(robot.sim.info.arm_geoms.tolist())
-    body = robot.sim.info.object_bodies[name]
-
-    def up(m: mujoco.MjModel, d: mujoco.MjData) -> float:
-        total, force = 0.0, np.zeros(6)
-        for i in range(d.ncon):
-            g1, g2 = d.contact.geom[i]
-            b1, b2 = m.geom_bodyid[g1], m.geom_bodyid[g2]
-            if body not in (b1, b2) or g1 in hand or g2 in hand or b1 == b2:
-                continue
-            mujoco.mj_contactForce(m, d, i, force)
-            on_second = d.contact.frame[i].reshape(3, 3).T @ force[:3]
-            total += float(on_second[2] if b2 == body else -on_second[2])
-        return total
-
-    return float(robot.sim.call(up))
+    """The upward force (N) on object `name` from everything but the arm and the gripper:
+    what it rests on, and anything pressing it into that (`Simulation._contacts`)."""
+    sim = robot.sim
+    ours = sim.model.geom_bodyid == sim.info.object_bodies[name]
+    arm = np.zeros(sim.model.ngeom, bool)
+    arm[sim.info.arm_geoms] = True
+    contacts = sim.call(lambda m, d: sim._contacts(ours, from_outside=True))
+    return float(sum(c.on_ours[2] for c in contacts if not arm[c.other]))
 
 
 def _recorded_moves(b: Behaviours) -> list[str]:
