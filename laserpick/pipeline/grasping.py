@@ -102,7 +102,7 @@ class GraspSet:
     def carried(self) -> np.ndarray:
         """The points (m, `base`) that stand for the target in the hand (`carried_shape`):
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
-        return carried_shape(self.target, self.stands_on)
+        return carried_shape(self.target, self.stands_on, frames=self.world.frames)
 
 
 def vertical_grasp(
