@@ -139,7 +139,7 @@ def test_an_object_cut_off_by_the_view_is_carried_on_beyond_its_edge():
     more = beyond_view(seen, [cut], 0.02, TOL)
     assert len(more)
     # It goes on the way the view cut it off, to the longest object carried...
-    assert more[:, 1].max() < seen[:, 1].min()
+    assert more[:, 1].max() < seen[:, 1].min() + 0.005
     reach = seen[:, 1].max() - more[:, 1].min()
     assert OBJECT_SPAN_MAX <= reach < OBJECT_SPAN_MAX + 0.02  # to within the 2 cm step
     # ...only where no camera saw past...

@@ -237,7 +237,7 @@ def carried_shape(
     target = np.asarray(target, float).reshape(-1, 3)
     if len(target) == 0:
         return target
-    cut = beyond_view(target[thin(target, voxel / 4)], frames, voxel, SEEN_TOLERANCE)
+    cut = beyond_view(target, frames, voxel, SEEN_TOLERANCE)
     if support is not None:
         cut = cut[cut[:, 2] > support]
     target = np.vstack([target, cut])
