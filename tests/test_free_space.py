@@ -147,10 +147,14 @@ def test_an_object_cut_off_by_the_view_is_carried_on_beyond_its_edge():
     # ...and at the height the bar was seen at its cut.
     assert more[:, 2].min() > BAR_CENTRE[2] - BAR_HALF[2] - 0.01
     assert more[:, 2].max() < BAR_CENTRE[2] + BAR_HALF[2] + 0.01
-    # The carried shape then spans the bar's whole length, where without the frames it
-    # spans what was seen.
-    assert carried_shape(seen, TABLE, frames=[cut])[:, 1].min() < far_end
+    # The carried shape then spans the bar's whole length, where from what was seen alone
+    # it spans that.
+    assert carried_shape(np.vstack([seen, more]), TABLE)[:, 1].min() < far_end
     assert carried_shape(seen, TABLE)[:, 1].min() > far_end + 0.02
+    # A view from elsewhere that saw the table past the bar's end ends it there.
+    whole = _frame(centre=BAR_CENTRE, half=BAR_HALF)
+    ended = beyond_view(seen, [cut], 0.02, TOL, others=[whole])
+    assert far_end - 0.02 < ended[:, 1].min() < far_end + 0.02
 
 
 def test_an_object_seen_whole_is_not_carried_on():

@@ -30,7 +30,7 @@ from laserpick.description.collision import (
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_D, UR5_HOME_Q, UR5_UNSTOW_Q
 from laserpick.description.kinematics import T_FLANGE_TCP
 from laserpick.pipeline.cloud import voxel_first
-from laserpick.pipeline.free_space import beyond_view, seen_free
+from laserpick.pipeline.free_space import seen_free
 from laserpick.pipeline.types import DepthFrame
 
 
@@ -216,15 +216,12 @@ def mirrored_back(
 
 
 def carried_shape(
-    target: np.ndarray,
-    support: float | None = None,
-    voxel: float = CARRIED_VOXEL,
-    frames: Sequence[DepthFrame] = (),
+    target: np.ndarray, support: float | None = None, voxel: float = CARRIED_VOXEL
 ) -> np.ndarray:
     """The points (m, `base`) that stand for an object the hand is about to carry: what the
-    cameras saw of it, carried on beyond their view's edge where that cut it off
-    (`beyond_view`, in the `frames` it was seen in), mirrored through the vertical axis of
-    its top, and reaching down to the surface it stands on.
+    cameras saw of it (and, where their view cut it off, what stands for the rest:
+    `beyond_view`), mirrored through the vertical axis of its top, and reaching down to the
+    surface it stands on.
 
     The cameras see an object from the front and above only, so its back half, and near a
     table's edge its lower part, are missing from `target` (N, 3); a carry planned around
@@ -237,10 +234,6 @@ def carried_shape(
     target = np.asarray(target, float).reshape(-1, 3)
     if len(target) == 0:
         return target
-    cut = beyond_view(target, frames, voxel, SEEN_TOLERANCE)
-    if support is not None:
-        cut = cut[cut[:, 2] > support]
-    target = np.vstack([target, cut])
     both = np.vstack([target, mirrored_back(target)[0]])
     if support is not None:
         columns, which = np.unique(np.floor(both[:, :2] / voxel), axis=0, return_inverse=True)

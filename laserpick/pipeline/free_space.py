@@ -79,20 +79,28 @@ def hidden(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -
 
 
 def beyond_view(
-    target: np.ndarray, frames: Sequence[DepthFrame], step: float, tolerance: float
+    target: np.ndarray,
+    frames: Sequence[DepthFrame],
+    step: float,
+    tolerance: float,
+    others: Sequence[DepthFrame] = (),
 ) -> np.ndarray:
     """Points (m, `base`) that stand for the part of an object the cameras' view cut off: none
     when no part of it lies at the view's edge.
 
-    target (N, 3), `base`: what the cameras saw of the object. A point lies at the view's
-    edge when it projects within VIEW_EDGE_PX of the border of some frame's image and well
-    inside none. The object may go on beyond: a carry planned around the seen part alone
-    swung a lying juice bottle's unseen 12 cm into the table it came from (164 N). So the
-    edge points are carried on, `step` (m) at a time, level (what stands or lies on a
-    surface goes on along it) and away from the seen part's middle, until the object spans
-    OBJECT_SPAN_MAX that way; a copy some camera saw past (by `tolerance`, m) is left out,
-    since the object is not there. Level, since the edge's own slant says little: the
-    bottle's top ran farther into the view than its side, which tilted the way 45 degrees up.
+    target (N, 3), `base`: what the cameras saw of the object in `frames`. A point lies at
+    the view's edge when it projects within VIEW_EDGE_PX of the border of some frame's
+    image and well inside none. The object may go on beyond: a lying juice bottle on the
+    108 cm table was seen 7.5 cm of its 20.6, and its unseen end, which no plan knew of, met
+    that table as the arm tucked it in (164 N).
+
+    So the edge points are carried on, `step` (m) at a time, away from the seen part's
+    middle, until the object spans OBJECT_SPAN_MAX that way. The way is level: what stands
+    or lies on a surface goes on along it, and the edge's own slant says little (the
+    bottle's top ran farther into the view than its side, which tilted the way 37 degrees
+    up). A copy some camera saw past (by `tolerance`, m), of `frames` or of `others` (views
+    from elsewhere), is left out: the object is not there; past the first step where most
+    are, it has ended.
     """
     target = np.asarray(target, np.float64).reshape(-1, 3)
     near_edge = np.zeros(len(target), bool)
@@ -117,7 +125,15 @@ def beyond_view(
     reach = OBJECT_SPAN_MAX - float(along.max() - along.min())
     steps = np.arange(1, int(np.ceil(reach / step)) + 1)[:, None, None] * step
     copies = (edge[None] + steps * way).reshape(-1, 3)
-    return copies[~seen_free(copies, frames, tolerance)] if len(copies) else copies
+    if not len(copies):
+        return copies
+    free = seen_free(copies, [*frames, *others], tolerance).reshape(len(steps), len(edge))
+    # The object ends at the first step most of whose copies a camera saw past. Before it,
+    # only the copies seen past are left out: a bottom row lies on the surface, never seen
+    # past, and would otherwise run on to OBJECT_SPAN_MAX.
+    ended = free.mean(axis=1) > 0.5
+    last = int(np.argmax(ended)) if ended.any() else len(steps)
+    return copies.reshape(len(steps), len(edge), 3)[:last][~free[:last]]
 
 
 def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:

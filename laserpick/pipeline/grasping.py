@@ -31,8 +31,14 @@ from laserpick.description.dims import (
     UR5_READY_Q,
     UR5_UNSTOW_Q,
 )
-from laserpick.pipeline.collision import CollisionChecker, carried_shape, mirrored_back
-from laserpick.pipeline.free_space import fingers_seen_free
+from laserpick.pipeline.collision import (
+    CARRIED_VOXEL,
+    SEEN_TOLERANCE,
+    CollisionChecker,
+    carried_shape,
+    mirrored_back,
+)
+from laserpick.pipeline.free_space import beyond_view, fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
@@ -71,7 +77,8 @@ class GraspSet:
     clusters: the reachable grasps, scored and clustered, best first. rejected: the
     candidates the filter dropped, each with its `ik_failure`. world: collision model of the
     whole cloud; surroundings: of the cloud without the target (the hand may touch it).
-    timings: seconds per stage: "detect", "filter", "select".
+    timings: seconds per stage: "detect", "filter", "select". cut_off: points (m, `base`)
+    that stand for the part of the target the cameras' view cut off (`beyond_view`).
     """
 
     clusters: GraspClusters
@@ -83,6 +90,7 @@ class GraspSet:
     timings: dict[str, float] = field(default_factory=dict)
     #: Height (m, `base`) of the surface the target stands on; None when none was found.
     support: float | None = None
+    cut_off: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def ordered(self) -> list[Grasp]:
         """Every reachable grasp, best cluster first and best first within each (004's order
@@ -102,7 +110,7 @@ class GraspSet:
     def carried(self) -> np.ndarray:
         """The points (m, `base`) that stand for the target in the hand (`carried_shape`):
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
-        return carried_shape(self.target, self.stands_on, frames=self.world.frames)
+        return carried_shape(np.vstack([self.target, self.cut_off]), self.stands_on)
 
 
 def vertical_grasp(
@@ -253,11 +261,16 @@ def find_grasps(
     t0 = time.perf_counter()
     recalled = recalled or Recalled()
     support = seg.surface.height if seg.surface is not None else None
+    cut_off = beyond_view(
+        target, perception.frames, CARRIED_VOXEL, SEEN_TOLERANCE, others=recalled.frames
+    )
+    if support is not None:
+        cut_off = cut_off[cut_off[:, 2] > support]
     blind = recalled.points
     if len(blind):
         # The views saw the target from elsewhere: what they saw of it that is hidden now
         # is the target, not an obstacle beside it. Its extent is the carry's model of it.
-        whole = carried_shape(target, support, voxel=TARGET_VOXEL)
+        whole = carried_shape(np.vstack([target, cut_off]), support, voxel=TARGET_VOXEL)
         blind = recalled.blind_points(perception.frames, whole, support)
     world, surroundings = CollisionChecker.world_and_surroundings(
         np.vstack([cloud.points, blind]) if len(blind) else cloud.points,
@@ -322,7 +335,9 @@ def find_grasps(
     scored = [score(g, q_now=q_ref, sample=target, mark=mark, settings=s.grasp) for g in ok]
     clusters = group(scored, s.grasp)
     timings["select"] = time.perf_counter() - t0
-    return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings, support)
+    return GraspSet(
+        clusters, rejected, world, surroundings, target, strategy, timings, support, cut_off
+    )
 
 
 def plan_first(
