@@ -153,7 +153,7 @@ def test_an_object_cut_off_by_the_view_is_carried_on_beyond_its_edge():
     assert carried_shape(seen, TABLE)[:, 1].min() > far_end + 0.02
     # A view from elsewhere that saw the table past the bar's end ends it there.
     whole = _frame(centre=BAR_CENTRE, half=BAR_HALF)
-    ended = beyond_view(seen, [cut], 0.02, TOL, others=[whole])
+    ended = beyond_view(seen, [cut], 0.02, TOL, TABLE, others=[whole])
     assert far_end - 0.02 < ended[:, 1].min() < far_end + 0.02
 
 

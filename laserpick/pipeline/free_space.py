@@ -83,6 +83,7 @@ def beyond_view(
     frames: Sequence[DepthFrame],
     step: float,
     tolerance: float,
+    support: float | None = None,
     others: Sequence[DepthFrame] = (),
 ) -> np.ndarray:
     """Points (m, `base`) that stand for the part of an object the cameras' view cut off: none
@@ -99,8 +100,9 @@ def beyond_view(
     or lies on a surface goes on along it, and the edge's own slant says little (the
     bottle's top ran farther into the view than its side, which tilted the way 37 degrees
     up). A copy some camera saw past (by `tolerance`, m), of `frames` or of `others` (views
-    from elsewhere), is left out: the object is not there; past the first step where most
-    are, it has ended.
+    from elsewhere), is left out: the object is not there. So is one within `tolerance` of
+    the `support` height (m) it stands on: no camera sees past a surface, and the carried
+    shape reaches down to it anyway (`carried_shape`).
     """
     target = np.asarray(target, np.float64).reshape(-1, 3)
     near_edge = np.zeros(len(target), bool)
@@ -127,13 +129,9 @@ def beyond_view(
     copies = (edge[None] + steps * way).reshape(-1, 3)
     if not len(copies):
         return copies
-    free = seen_free(copies, [*frames, *others], tolerance).reshape(len(steps), len(edge))
-    # The object ends at the first step most of whose copies a camera saw past. Before it,
-    # only the copies seen past are left out: a bottom row lies on the surface, never seen
-    # past, and would otherwise run on to OBJECT_SPAN_MAX.
-    ended = free.mean(axis=1) > 0.5
-    last = int(np.argmax(ended)) if ended.any() else len(steps)
-    return copies.reshape(len(steps), len(edge), 3)[:last][~free[:last]]
+    if support is not None:
+        copies = copies[copies[:, 2] > support + tolerance]
+    return copies[~seen_free(copies, [*frames, *others], tolerance)]
 
 
 def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:

@@ -262,10 +262,8 @@ def find_grasps(
     recalled = recalled or Recalled()
     support = seg.surface.height if seg.surface is not None else None
     cut_off = beyond_view(
-        target, perception.frames, CARRIED_VOXEL, SEEN_TOLERANCE, others=recalled.frames
+        target, perception.frames, CARRIED_VOXEL, SEEN_TOLERANCE, support, recalled.frames
     )
-    if support is not None:
-        cut_off = cut_off[cut_off[:, 2] > support]
     blind = recalled.points
     if len(blind):
         # The views saw the target from elsewhere: what they saw of it that is hidden now
