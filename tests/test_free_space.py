@@ -1,11 +1,12 @@
-"""The free-space test: a point is free where a camera saw past it. Depth images rendered
-here by casting each pixel's ray at a box on a table, so where the box hides space is known
-exactly."""
+"""The free-space test: a point is free where a camera saw past it; and what a camera's view
+cut off an object is carried on past its edge. Depth images rendered here by casting each
+pixel's ray at a box on a table, so where the box hides space is known exactly."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from laserpick.description import dims
 from laserpick.pipeline.collision import carried_shape
 from laserpick.pipeline.free_space import (
     OBJECT_SPAN_MAX,
@@ -15,7 +16,16 @@ from laserpick.pipeline.free_space import (
     hidden,
     seen_free,
 )
-from laserpick.pipeline.types import DepthFrame, Grasp
+from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.types import (
+    DepthFrame,
+    FusedCloud,
+    Grasp,
+    LaserMark,
+    Segmentation,
+    SupportSurface,
+)
 from laserpick.settings import GraspSettings
 
 TABLE = 0.46
@@ -117,6 +127,7 @@ def test_a_finger_in_the_box_unseen_back_is_refused_one_beside_it_is_not():
 
 BAR_CENTRE = np.array([1.5, 0.0, TABLE + 0.03])
 BAR_HALF = np.array([0.03, 0.10, 0.03])  # a 6 x 20 x 6 cm bar lying across the view
+UP, FRONT = np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0])
 
 
 def _seen_surface(frame: DepthFrame, centre: np.ndarray, half: np.ndarray) -> np.ndarray:
@@ -165,3 +176,33 @@ def test_an_object_seen_whole_is_not_carried_on():
     # Cut off in one camera's view, but seen whole in another's: not cut off.
     cut = _frame(centre=BAR_CENTRE, half=BAR_HALF, look_at=BAR_CENTRE + [0, 0.15, -0.03], f=500)
     assert len(beyond_view(seen, [cut, whole], 0.02, TOL)) == 0
+
+
+def test_find_grasps_carries_a_target_the_view_cut_off_on_past_its_edge():
+    cut = _frame(centre=BAR_CENTRE, half=BAR_HALF, look_at=BAR_CENTRE + [0, 0.15, -0.03], f=500)
+    bar = _seen_surface(cut, BAR_CENTRE, BAR_HALF)
+    bar_normals = np.where((bar[:, 2] > BAR_CENTRE[2] + BAR_HALF[2] - 1e-9)[:, None], UP, FRONT)
+    x, y = np.meshgrid(np.arange(1.2, 1.8, 0.006), np.arange(-0.3, 0.3, 0.006))
+    table = np.c_[x.ravel(), y.ravel(), np.full(x.size, TABLE)]
+    table = table[~hidden(table, [cut], TOL)]
+    n = len(bar) + len(table)
+    cloud = FusedCloud(
+        np.vstack([bar, table]).astype(np.float32),
+        np.vstack([bar_normals, np.tile(UP, (len(table), 1))]).astype(np.float32),
+        np.zeros(n, np.uint8),
+        np.arange(n, dtype=np.int32),
+        ("front",),
+    )
+    surface = SupportSurface(TABLE, np.array([0.0, 0.0, 1.0, -TABLE]))
+    seg = Segmentation(np.arange(len(bar)), "cluster", surface)
+    mark = LaserMark(bar[np.argmax(bar[:, 2])], "confirmed", 0, "direct")
+    far_end = BAR_CENTRE[1] - BAR_HALF[1]
+    found = find_grasps(Perception(cloud, mark, seg, None, frames=(cut,)), dims.UR5_READY_Q)
+    assert isinstance(found, GraspSet), found
+    assert found.cut_off[:, 1].min() < far_end
+    assert found.cut_off[:, 2].min() > TABLE  # none on the table it stands on
+    assert found.carried[:, 1].min() < far_end
+    # Without the frames it was seen in, nothing says the view cut it off.
+    alone = find_grasps(Perception(cloud, mark, seg, None), dims.UR5_READY_Q)
+    assert isinstance(alone, GraspSet) and len(alone.cut_off) == 0
+    assert alone.carried[:, 1].min() > far_end + 0.02
