@@ -112,6 +112,11 @@ class GraspSet:
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
         return carried_shape(np.vstack([self.target, self.cut_off]), self.stands_on)
 
+    @functools.cached_property
+    def carried_as_seen(self) -> np.ndarray:
+        """`carried` without `cut_off`: the target as the cameras saw it (m, `base`)."""
+        return carried_shape(self.target, self.stands_on)
+
 
 def vertical_grasp(
     target: np.ndarray, support: float | None, settings: Settings
