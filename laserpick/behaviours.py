@@ -95,6 +95,15 @@ LEAVE_LEVEL = np.radians(20.0)
 LEAVE_DROP = 0.005
 LEAVE_SPEED = 0.02
 LEAVE_SETTLE = 0.3  #: s the lowered hand is given to get there
+#: An open hand whose pads still feel more than PADS_CLEAR (N) before it leaves is eased
+#: LEAVE_SHIFT (m) sideways along its closing axis, one way then the other, stopped where
+#: the pads feel LEAVE_NUDGE (N) more than when it started (`Behaviours._ease_pads_off`). A
+#: pill bottle let go on the floor from the side sprang 1.6 cm onto the right pad and leaned
+#: on it (0.4 N): the hand, risen straight up, took it 10 cm up hanging on the open pad.
+#: Lighter than `GRIPPER_HOLD_FORCE`: the pads read exactly nothing when they touch nothing.
+PADS_CLEAR = 0.2
+LEAVE_SHIFT = 0.015
+LEAVE_NUDGE = 0.5
 #: Times the tuck searches for a way before it raises the object in front instead: each
 #: search is random, and from a hand just drawn out of the 69 cm shelf's gap the second found
 #: the way the first had not (the session's retreat then tucked it in, the task failed).
@@ -990,7 +999,8 @@ class Behaviours:
         found, where rising straight up from the cereal box it had set down found one. A
         hand whose open pads still press something (`_caught`) is lowered first from any
         approach: the finger that had dragged a mug 3.6 cm as it opened then lifted it 9 cm
-        by its handle; lowered, it came free."""
+        by its handle; lowered, it came free. Pads that still feel anything then are eased
+        off it sideways (`_ease_pads_off`), and the hand leaves from there."""
         start = tcp_pose(self._q())
         approach = start[:3, 2]
         back = self._withdrawal(approach, checker, level=False)
@@ -998,10 +1008,48 @@ class Behaviours:
         if self._caught() or (back is not None and level):
             self._lower_open_hand(start)
             back = self._withdrawal(approach, checker, level=False)
+        eased = self._ease_pads_off()
+        if eased.any():
+            back = self._withdrawal(approach, checker, level=False)
         if back is None:
-            self._rise_straight(T_above, "rising from the object")
+            T_up = T_above.copy()
+            T_up[:3, 3] += eased
+            self._rise_straight(T_up, "rising from the object")
             return None
         return self._draw_back(back)
+
+    def _ease_pads_off(self) -> np.ndarray:
+        """Ease the open hand sideways off what its pads still touch, and say how far it
+        moved (3,) (m, `base`; zero where they touch nothing, or where neither way frees
+        them: then it is back where it started).
+
+        Along the closing axis by LEAVE_SHIFT, first one way and then the other, slowly and
+        guarded at LEAVE_NUDGE over what the pads bear: the gripper feels only the pads'
+        summed force, not which pad, so the way into the object is found by touch, and
+        stops before it pushes it over. Rising with a pill bottle leaning on one open pad,
+        the hand lifted it off the floor and carried it away."""
+        felt = self._pads_feel()
+        if felt <= PADS_CLEAR:
+            return np.zeros(3)
+        s = self.settings.motion
+        start = tcp_pose(self._q())
+        for sign in (1.0, -1.0):
+            T = start.copy()
+            T[:3, 3] += sign * LEAVE_SHIFT * start[:3, 1]
+            path = cartesian_line(self._q(), T, s.cartesian_step / 5)
+            if path is None:
+                continue
+            aside = timed(path, s, tcp_speed=LEAVE_SPEED)
+            guard = self._pads_feel() + LEAVE_NUDGE
+            self._run(Trajectory(aside.times, aside.q, guard_force=guard), "easing the pads off")
+            self.robot.sleep(LEAVE_SETTLE)
+            if self._pads_feel() <= PADS_CLEAR:
+                return tcp_pose(self._q())[:3, 3] - start[:3, 3]
+        # Touched both ways (or could not move): back to where it let go, as slowly.
+        home = cartesian_line(self._q(), start, s.cartesian_step / 5)
+        if home is not None:
+            self._run(timed(home, s, tcp_speed=LEAVE_SPEED), "easing back between")
+        return np.zeros(3)
 
     def _lower_open_hand(self, start: np.ndarray) -> None:
         """Lower the open hand LEAVE_DROP straight down from TCP pose `start` (4, 4, `base`),

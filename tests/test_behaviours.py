@@ -16,9 +16,11 @@ from laserpick.behaviours import (
     DROP_TRIES,
     FALL_STEP,
     LEAVE_DROP,
+    LEAVE_SHIFT,
     MARK_MOVES,
     OVERHANG_FALL_STEP,
     OVERHANG_STEP,
+    PADS_CLEAR,
     PLACE_YAWS,
     SUPPORT_SCATTER,
     Behaviours,
@@ -957,6 +959,56 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         assert moves == ["freeing the fingers", "rising off what the fingers met", "drawing back"]
         moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
         np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
+    finally:
+        robot.close()
+
+
+@pytest.mark.parametrize("lean", [0.026, -0.026], ids=["first-way-in", "first-way-out"])
+def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(lean: float):
+    """Let go on the floor, a pill bottle sprang onto one open pad and leaned on it (0.4 N,
+    well under GRIPPER_HOLD_FORCE) with its cap's lip over the pad: the hand, risen
+    straight up, took it 10 cm up (and so did this test's hand, before the fix). An open
+    hand whose pads still feel something is first eased sideways along its closing axis.
+    The gripper feels only the pads' sum, not which pad, so the first way it tries may push
+    into the bottle: the guard stops it there, and the other way frees the pad."""
+    robot = SimRobot(load_scene(str(DATA / "pill_lean.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        referee = Referee(robot)
+        bottle = referee.position("pill_bottle_1")
+        b = Behaviours(robot)
+        s = b.settings.motion
+        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up).
+        z = bottle[2] + 0.057
+        top = np.mgrid[1.65:2.25:0.02, -0.65:0.35:0.02].reshape(2, -1).T
+        table = CollisionChecker(np.c_[top, np.full(len(top), bottle[2])], margin=0.0)
+        out_front = _side_pose(bottle[0] - 0.10, bottle[1], z)
+        q = next(q for q in ik_tcp(out_front, dims.UR5_READY_Q) if table.clearance_ok(q)[0])
+        assert b.go_to(q, table, "test").ok
+        for y, speed in ((bottle[1], 0.03), (bottle[1] + lean, 0.01)):  # about it, then aside
+            path = cartesian_line(robot.joint_state().q, _side_pose(bottle[0], y, z))
+            assert path is not None and b._run(timed(path, s, tcp_speed=speed), "test") is None
+        robot.sleep(0.5)
+        assert PADS_CLEAR < robot.gripper_state().force < dims.GRIPPER_HOLD_FORCE
+        start = tcp_pose(robot.joint_state().q)
+        above = start.copy()
+        above[2, 3] += 0.10
+        # A post behind the hand: no way back, so it rises straight up, as on the floor.
+        post = np.array(
+            [[bottle[0] - 0.07, start[1, 3], h] for h in np.arange(z - 0.05, z + 0.3, 0.01)]
+        )
+        moves = _recorded_moves(b)
+        assert b._leave_placed(above, CollisionChecker(post)) is None
+        # The side pose's closing axis is +y, the first way tried. Moved +y, the hand's -y pad
+        # presses the bottle, and +y pushes it into the bottle; moved -y, +y frees the pad.
+        eased = 2 if lean > 0 else 1
+        assert moves == ["easing the pads off"] * eased + ["rising from the object"]
+        robot.sleep(1.0)
+        assert robot.gripper_state().force <= PADS_CLEAR
+        assert abs(referee.position("pill_bottle_1")[2] - bottle[2]) < 0.003, "left on the table"
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        np.testing.assert_allclose(end[1], start[1, 3] - np.sign(lean) * LEAVE_SHIFT, atol=0.003)
+        assert end[2] > z + 0.09, "and the hand rose"
     finally:
         robot.close()
 
