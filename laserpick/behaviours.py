@@ -95,13 +95,15 @@ LEAVE_LEVEL = np.radians(20.0)
 LEAVE_DROP = 0.005
 LEAVE_SPEED = 0.02
 LEAVE_SETTLE = 0.3  #: s the lowered hand is given to get there
-#: An open hand whose pads still feel more than PADS_CLEAR (N) before it leaves is eased
-#: LEAVE_SHIFT (m) sideways along its closing axis, one way then the other, stopped where
-#: the pads feel LEAVE_NUDGE (N) more than when it started (`Behaviours._ease_pads_off`). A
-#: pill bottle let go on the floor from the side sprang 1.6 cm onto the right pad and leaned
-#: on it (0.4 N): the hand, risen straight up, took it 10 cm up hanging on the open pad.
-#: Lighter than `GRIPPER_HOLD_FORCE`: the pads read exactly nothing when they touch nothing.
+#: An open hand whose pads still feel more than PADS_CLEAR (N) before it leaves is lowered
+#: (LEAVE_DROP), then, if they still do, eased LEAVE_SHIFT (m) sideways along its closing
+#: axis, one way then the other, stopped where the pads feel LEAVE_NUDGE (N) more than when
+#: it started (`Behaviours._ease_pads_off`). A pill bottle let go on the floor from the side
+#: sprang 1.6 cm onto the right pad and hung on its top edge by the cap's lip (0.4 N): the
+#: hand, risen straight up, took it 10 cm up; eased sideways unlowered, it dragged it along.
+#: Far under `GRIPPER_HOLD_FORCE`: the pads read exactly nothing when they touch nothing.
 PADS_CLEAR = 0.2
+FEEL_PERIOD = 0.05  #: s between the pad readings taken while the hand stands still
 LEAVE_SHIFT = 0.015
 LEAVE_NUDGE = 0.5
 #: Times the tuck searches for a way before it raises the object in front instead: each
@@ -596,9 +598,19 @@ class Behaviours:
         """What the pads press on (N): the gripper's own sensing."""
         return self.robot.gripper_state().force
 
+    def _pads_feel_over(self, seconds: float) -> float:
+        """The most the pads feel (N) over the next `seconds` of robot time. One reading
+        flickers: a pad pressed against a rail read 0 N, then 0.95 N a tenth of a second
+        later."""
+        most = self._pads_feel()
+        for _ in range(round(seconds / FEEL_PERIOD)):
+            self.robot.sleep(FEEL_PERIOD)
+            most = max(most, self._pads_feel())
+        return most
+
     def _caught(self) -> bool:
         """Whether the open hand's pads still press what they let go of (or anything)."""
-        return self._pads_feel() > dims.GRIPPER_HOLD_FORCE
+        return self._pads_feel_over(LEAVE_SETTLE) > PADS_CLEAR
 
     def _gripping(self) -> bool:
         state = self.robot.gripper_state()
@@ -998,18 +1010,20 @@ class Behaviours:
         close along the 31 cm table's top, and from where it ended no way to ready was
         found, where rising straight up from the cereal box it had set down found one. A
         hand whose open pads still press something (`_caught`) is lowered first from any
-        approach: the finger that had dragged a mug 3.6 cm as it opened then lifted it 9 cm
-        by its handle; lowered, it came free. Pads that still feel anything then are eased
-        off it sideways (`_ease_pads_off`), and the hand leaves from there."""
+        approach (PADS_CLEAR): the finger that had dragged a mug 3.6 cm as it opened then
+        lifted it 9 cm by its handle; lowered, it came free. Pads that still feel anything
+        then are eased off it sideways (`_ease_pads_off`), and the hand leaves from there."""
         start = tcp_pose(self._q())
         approach = start[:3, 2]
         back = self._withdrawal(approach, checker, level=False)
         level = abs(approach[2]) < np.sin(LEAVE_LEVEL)
-        if self._caught() or (back is not None and level):
+        caught = self._caught()
+        if caught or (back is not None and level):
             self._lower_open_hand(start)
             back = self._withdrawal(approach, checker, level=False)
-        eased = self._ease_pads_off()
-        if eased.any():
+        eased = np.zeros(3)
+        if caught:  # even if lowered they feel nothing: what leaned on a pad still leans
+            eased = self._ease_pads_off()
             back = self._withdrawal(approach, checker, level=False)
         if back is None:
             T_up = T_above.copy()
@@ -1019,18 +1033,14 @@ class Behaviours:
         return self._draw_back(back)
 
     def _ease_pads_off(self) -> np.ndarray:
-        """Ease the open hand sideways off what its pads still touch, and say how far it
-        moved (3,) (m, `base`; zero where they touch nothing, or where neither way frees
-        them: then it is back where it started).
+        """Ease the open hand sideways off what its pads touched, and say how far it moved
+        (3,) (m, `base`).
 
-        Along the closing axis by LEAVE_SHIFT, first one way and then the other, slowly and
-        guarded at LEAVE_NUDGE over what the pads bear: the gripper feels only the pads'
-        summed force, not which pad, so the way into the object is found by touch, and
-        stops before it pushes it over. Rising with a pill bottle leaning on one open pad,
-        the hand lifted it off the floor and carried it away."""
-        felt = self._pads_feel()
-        if felt <= PADS_CLEAR:
-            return np.zeros(3)
+        Along the closing axis by LEAVE_SHIFT, one way and, where the pads still feel
+        something there, the other, slowly and guarded at LEAVE_NUDGE over what the pads
+        bear: the gripper feels only the pads' summed force, not which pad, so the way into
+        the object is found by touch, and stopped before it pushes the object over. Rising
+        with a pill bottle leaning on one open pad, the hand lifted it and carried it off."""
         s = self.settings.motion
         start = tcp_pose(self._q())
         for sign in (1.0, -1.0):
@@ -1042,14 +1052,11 @@ class Behaviours:
             aside = timed(path, s, tcp_speed=LEAVE_SPEED)
             guard = self._pads_feel() + LEAVE_NUDGE
             self._run(Trajectory(aside.times, aside.q, guard_force=guard), "easing the pads off")
-            self.robot.sleep(LEAVE_SETTLE)
-            if self._pads_feel() <= PADS_CLEAR:
-                return tcp_pose(self._q())[:3, 3] - start[:3, 3]
-        # Touched both ways (or could not move): back to where it let go, as slowly.
-        home = cartesian_line(self._q(), start, s.cartesian_step / 5)
-        if home is not None:
-            self._run(timed(home, s, tcp_speed=LEAVE_SPEED), "easing back between")
-        return np.zeros(3)
+            if not self._caught():
+                break
+        # Touching either way, it leaves from where it is: pushed back between, unguarded, a
+        # pill bottle that had followed the pad was pushed with 4.8 N.
+        return tcp_pose(self._q())[:3, 3] - start[:3, 3]
 
     def _lower_open_hand(self, start: np.ndarray) -> None:
         """Lower the open hand LEAVE_DROP straight down from TCP pose `start` (4, 4, `base`),

@@ -968,9 +968,11 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
     """Let go on the floor, a pill bottle sprang onto one open pad and leaned on it (0.4 N,
     well under GRIPPER_HOLD_FORCE) with its cap's lip over the pad: the hand, risen
     straight up, took it 10 cm up (and so did this test's hand, before the fix). An open
-    hand whose pads still feel something is first eased sideways along its closing axis.
-    The gripper feels only the pads' sum, not which pad, so the first way it tries may push
-    into the bottle: the guard stops it there, and the other way frees the pad."""
+    hand whose pads still feel something is lowered 5 mm, which here leaves the pads
+    feeling nothing while the bottle still leans over one, and then eased sideways along
+    its closing axis. The gripper feels only the pads' sum, not which pad, so the first
+    way it tries may push into the bottle: the guard stops it there, and the other way
+    frees the pad."""
     robot = SimRobot(load_scene(str(DATA / "pill_lean.yaml"), seed=1), realtime=False)
     try:
         robot.sim.settle(0.5)
@@ -978,7 +980,8 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         bottle = referee.position("pill_bottle_1")
         b = Behaviours(robot)
         s = b.settings.motion
-        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up).
+        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up). The
+        # table's front edge is 6 mm behind the bottle: a wrist over it would meet it.
         z = bottle[2] + 0.057
         top = np.mgrid[1.65:2.25:0.02, -0.65:0.35:0.02].reshape(2, -1).T
         table = CollisionChecker(np.c_[top, np.full(len(top), bottle[2])], margin=0.0)
@@ -1002,7 +1005,9 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         # The side pose's closing axis is +y, the first way tried. Moved +y, the hand's -y pad
         # presses the bottle, and +y pushes it into the bottle; moved -y, +y frees the pad.
         eased = 2 if lean > 0 else 1
-        assert moves == ["easing the pads off"] * eased + ["rising from the object"]
+        assert moves == ["freeing the fingers"] + ["easing the pads off"] * eased + [
+            "rising from the object"
+        ]
         robot.sleep(1.0)
         assert robot.gripper_state().force <= PADS_CLEAR
         assert abs(referee.position("pill_bottle_1")[2] - bottle[2]) < 0.003, "left on the table"
@@ -1017,8 +1022,8 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
     """Opened, a finger still pressed a mug it had dragged by its handle (8.9 N), and drawn
     straight up, it lifted the mug 9 cm by the handle's top bar. Lowered first, it came
     free. An open hand whose pads still press something is lowered first from any
-    approach, guarded over what the pads already bear. Here the open hand straddles a rail
-    from above, one pad pressed against it."""
+    approach, guarded over what the pads already bear, then eased sideways off it. Here
+    the open hand straddles a rail from above, one pad pressed against it."""
     robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
     try:
         robot.sim.settle(0.5)
@@ -1043,9 +1048,13 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
         assert b._leave_placed(above, free) is None
         assert moves[0] == "freeing the fingers"
         assert moves[-1] == "drawing back"
-        # Lowered LEAVE_DROP (or less, where the guard stopped it), then drawn straight up.
+        # Lowered LEAVE_DROP (or less, where the guard stopped it), eased sideways off the
+        # rail (the -y pad pressed the rail's -y face from outside: away is -y), then drawn
+        # straight up.
         end = tcp_pose(robot.joint_state().q)[:3, 3]
-        np.testing.assert_allclose(end[:2], above[:2, 3], atol=0.005)
+        assert "easing the pads off" in moves
+        np.testing.assert_allclose(end[0], above[0, 3], atol=0.005)
+        assert above[1, 3] - LEAVE_SHIFT - 0.003 < end[1] < above[1, 3] - LEAVE_SHIFT / 2
         assert above[2, 3] - LEAVE_DROP - 0.003 < end[2] < above[2, 3] + 0.003
     finally:
         robot.close()
