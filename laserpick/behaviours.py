@@ -96,12 +96,13 @@ LEAVE_DROP = 0.005
 LEAVE_SPEED = 0.02
 LEAVE_SETTLE = 0.3  #: s the lowered hand is given to get there
 #: An open hand whose pads still feel more than PADS_CLEAR (N) before it leaves is lowered
-#: (LEAVE_DROP), then, if they still do, eased LEAVE_SHIFT (m) sideways along its closing
-#: axis, one way then the other, stopped where the pads feel LEAVE_NUDGE (N) more than when
-#: it started (`Behaviours._ease_pads_off`). A pill bottle let go on the floor from the side
-#: sprang 1.6 cm onto the right pad and hung on its top edge by the cap's lip (0.4 N): the
-#: hand, risen straight up, took it 10 cm up; eased sideways unlowered, it dragged it along.
-#: Far under `GRIPPER_HOLD_FORCE`: the pads read exactly nothing when they touch nothing.
+#: (LEAVE_DROP), then eased LEAVE_SHIFT (m) sideways along its closing axis, one way and, if
+#: the pads still feel something, the other, stopped where they feel LEAVE_NUDGE (N) more
+#: than when it started (`Behaviours._ease_pads_off`). A pill bottle let go on the floor
+#: from the side sprang 1.6 cm onto the right pad and hung on its top edge by the cap's lip
+#: (0.4 N): the hand, risen straight up, took it 10 cm up; eased sideways unlowered, it
+#: dragged it along. Far under `GRIPPER_HOLD_FORCE`: the simulated pads read exactly nothing
+#: when they touch nothing; a real gripper's reading needs PADS_CLEAR above its noise.
 PADS_CLEAR = 0.2
 FEEL_PERIOD = 0.05  #: s between the pad readings taken while the hand stands still
 LEAVE_SHIFT = 0.015
@@ -609,7 +610,8 @@ class Behaviours:
         return most
 
     def _caught(self) -> bool:
-        """Whether the open hand's pads still press what they let go of (or anything)."""
+        """Whether the open hand's pads still press what they let go of (or anything): more
+        than PADS_CLEAR over LEAVE_SETTLE."""
         return self._pads_feel_over(LEAVE_SETTLE) > PADS_CLEAR
 
     def _gripping(self) -> bool:
@@ -1051,6 +1053,7 @@ class Behaviours:
                 continue
             aside = timed(path, s, tcp_speed=LEAVE_SPEED)
             guard = self._pads_feel() + LEAVE_NUDGE
+            # Stopped at the guard is how the way into the object is found: not a failure.
             self._run(Trajectory(aside.times, aside.q, guard_force=guard), "easing the pads off")
             if not self._caught():
                 break

@@ -980,8 +980,8 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         bottle = referee.position("pill_bottle_1")
         b = Behaviours(robot)
         s = b.settings.motion
-        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up). The
-        # table's front edge is 6 mm behind the bottle: a wrist over it would meet it.
+        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up); the
+        # wrist stays in front of the table's edge, 6 cm before the bottle's middle.
         z = bottle[2] + 0.057
         top = np.mgrid[1.65:2.25:0.02, -0.65:0.35:0.02].reshape(2, -1).T
         table = CollisionChecker(np.c_[top, np.full(len(top), bottle[2])], margin=0.0)
