@@ -1003,7 +1003,7 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         moves = _recorded_moves(b)
         assert b._leave_placed(above, CollisionChecker(post)) is None
         # The side pose's closing axis is +y, the first way tried. Moved +y, the hand's -y pad
-        # presses the bottle, and +y pushes it into the bottle; moved -y, +y frees the pad.
+        # presses the bottle, and +y takes that pad into it; moved -y, +y frees the +y pad.
         eased = 2 if lean > 0 else 1
         assert moves == ["freeing the fingers"] + ["easing the pads off"] * eased + [
             "rising from the object"
