@@ -1014,7 +1014,9 @@ class Behaviours:
         hand whose open pads still press something (`_caught`) is lowered first from any
         approach (PADS_CLEAR): the finger that had dragged a mug 3.6 cm as it opened then
         lifted it 9 cm by its handle; lowered, it came free. Pads that still feel anything
-        then are eased off it sideways (`_ease_pads_off`), and the hand leaves from there."""
+        then are eased off it sideways (`_ease_pads_off`), and the hand leaves from there:
+        risen straight up, it goes up beside the way it came down, by as much as it was
+        eased (at most LEAVE_SHIFT), unchecked as that way is."""
         start = tcp_pose(self._q())
         approach = start[:3, 2]
         back = self._withdrawal(approach, checker, level=False)
