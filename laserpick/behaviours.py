@@ -178,14 +178,16 @@ class Outcome:
 class Held:
     """What the hand holds after a pick: the grasp, its height above the support surface (m)
     (for placing, 004 section 7.3), the object's points in the TCP frame (m, thinned, its
-    unseen back filled in by `carried_shape`: the planner carries them with the hand), the
-    obstacles around it (`base`), and the odometry's pose (x, y, yaw; m, rad) where they
+    unseen back filled in by `carried_shape`: the planner carries them with the hand), its
+    middle in the TCP frame (m; `object_middle`: a place that turns it turns it about this),
+    the obstacles around it (`base`), and the odometry's pose (x, y, yaw; m, rad) where they
     were seen (None: not tied to a place). Once the scooter has moved, the obstacles must be
     taken anew (`Session._held_here`)."""
 
     grasp: Grasp
     height_above_support: float
     points_tcp: np.ndarray
+    middle_tcp: np.ndarray
     surroundings: CollisionChecker
     seen_from: np.ndarray | None = None
 
@@ -484,7 +486,8 @@ class Behaviours:
         pts_tcp = grasp.in_hand(pts)
         around = self._without_leftovers(grasps.surroundings, pts, support)
         height = float(grasp.position[2] - support)
-        self.held = Held(grasp, height, pts_tcp, around, self.robot.base_pose())
+        middle = grasp.in_hand(grasps.middle[None])[0]
+        self.held = Held(grasp, height, pts_tcp, middle, around, self.robot.base_pose())
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)
@@ -1130,8 +1133,7 @@ class Behaviours:
         surface = np.abs(checker.points[:, 2] - spot[2]) < SURFACE_BAND
         around, support = checker.without(surface), checker.without(~surface)
         # The middle of the held object, from the hand (m, `base` axes at the grasp).
-        pts = held.points_tcp @ held.grasp.pose[:3, :3].T
-        middle = (pts.min(axis=0) + pts.max(axis=0)) / 2 if len(pts) else np.zeros(3)
+        middle = held.grasp.pose[:3, :3] @ held.middle_tcp
         rest = spot[2] + held.height_above_support  # the hand's height with the object down
         for dyaw in PLACE_YAWS:
             T_place = held.grasp.pose.copy()

@@ -1128,7 +1128,11 @@ def test_the_hand_comes_down_turned_where_the_arm_would_come_down_on_something(r
     ring = np.linspace(0, 2 * np.pi, 12, endpoint=False)
     can = np.c_[0.03 * np.cos(ring), 0.03 * np.sin(ring), 0 * ring]
     held = Held(
-        Grasp(pose=side, width=0.06, ik=q_side), 0.05, can, CollisionChecker(np.zeros((0, 3)))
+        Grasp(pose=side, width=0.06, ik=q_side),
+        0.05,
+        can,
+        np.zeros(3),
+        CollisionChecker(np.zeros((0, 3))),
     )
     spot = np.array([1.60, -0.30, 0.70])
     found = b._place_poses(held, spot, q_side, CollisionChecker(np.zeros((0, 3))))
@@ -1166,7 +1170,8 @@ def test_an_object_held_by_one_end_is_tucked_in_with_the_hand_turned_away_from_t
     free = CollisionChecker(np.zeros((0, 3)))
     assert not free.clearance_ok(dims.UR5_CARRY_Q, payload=rod)[0]
     assert not free.clearance_ok(dims.UR5_HIGH_READY_Q, payload=rod)[0]
-    b.held = Held(Grasp(pose=tcp_pose(b._q()), width=0.03, ik=b._q()), 0.02, rod, free)
+    middle = (rod.min(axis=0) + rod.max(axis=0)) / 2
+    b.held = Held(Grasp(pose=tcp_pose(b._q()), width=0.03, ik=b._q()), 0.02, rod, middle, free)
     out = b.tuck()
     assert out.ok, out.failure
     q = robot.joint_state().q
@@ -1195,7 +1200,8 @@ def test_the_arm_may_come_down_near_the_surface_it_sets_an_object_on_but_not_int
     for h, ok in ((0.05, True), (0.04, False)):
         side = _side_pose(1.60, -0.30, top + h)
         q_side = ik_tcp(side, dims.UR5_READY_Q)[0]
-        held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, support)
+        middle = (jar.min(axis=0) + jar.max(axis=0)) / 2
+        held = Held(Grasp(pose=side, width=0.04, ik=q_side), h, jar, middle, support)
         found = b._place_poses(held, spot, q_side, support)
         assert isinstance(found, Failure) != ok, (h, found)
         if not ok:  # the refusal says what the wrist would reach into

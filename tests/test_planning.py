@@ -20,6 +20,7 @@ from laserpick.pipeline.collision import (
     CollisionChecker,
     carried_shape,
     held_clear_of_arm,
+    object_middle,
     self_filter,
     sphere_centres,
     surface_front,
@@ -187,6 +188,35 @@ def test_carried_shape_fills_in_the_unseen_back_of_a_can():
     filled = carried_shape(upper, support=0.46)
     assert filled[:, 2].min() < 0.46 + 0.02
     assert np.all(np.abs(filled[:, :2] - axis).max(axis=1) < r + 0.03)  # within the footprint
+
+
+def test_the_middle_of_a_box_whose_top_was_seen_in_part_is_the_middle_of_its_seen_width():
+    """A 6 x 19 x 25 cm box standing on the 100 cm shelf, seen from the front (-x): its front
+    face whole up to 5 cm under its top; above that, and of its top, only the 15 cm nearest
+    its +y end (as the cameras saw the kitchen's cereal box). The half turn about the middle
+    of that top carries the box on past its +y end, so the carried shape's middle lies 2 cm
+    off the box's. The middle a place turns it about must be the box's own, within 5 mm."""
+    middle = np.array([1.60, -0.31])
+    lo, hi = middle - [0.03, 0.095], middle + [0.03, 0.095]
+    y, z = np.meshgrid(np.arange(lo[1], hi[1] + 1e-9, 0.005), np.arange(1.0, 1.25 + 1e-9, 0.005))
+    y, z = y.ravel(), z.ravel()
+    keep = (z < 1.20) | (y > hi[1] - 0.15)
+    front = np.c_[np.full(keep.sum(), lo[0]), y[keep], z[keep]]
+    x, y = np.meshgrid(np.arange(lo[0], hi[0] + 1e-9, 0.005), np.arange(hi[1] - 0.15, hi[1], 0.005))
+    seen = np.vstack([front, np.c_[x.ravel(), y.ravel(), np.full(x.size, 1.25)]])
+    carried = carried_shape(seen, support=1.0)
+    carried_middle = (carried.min(axis=0) + carried.max(axis=0)) / 2
+    assert abs(carried_middle[1] - middle[1]) > 0.015  # the half turn's guess is off
+    found = object_middle(seen, carried)
+    assert found[:2] == pytest.approx(middle, abs=0.005)
+    assert found[2] == pytest.approx(1.125, abs=0.02)
+    # Seen whole, top and all, it is the carried shape's middle, and the box's.
+    x, y = np.meshgrid(np.arange(lo[0], hi[0] + 1e-9, 0.005), np.arange(lo[1], hi[1], 0.005))
+    whole = np.vstack([front, np.c_[x.ravel(), y.ravel(), np.full(x.size, 1.25)]])
+    carried = carried_shape(whole, support=1.0)
+    found = object_middle(whole, carried)
+    assert found == pytest.approx((carried.min(axis=0) + carried.max(axis=0)) / 2, abs=2e-3)
+    assert found[:2] == pytest.approx(middle, abs=0.005)
 
 
 def test_surface_front_walls_in_a_counter_front_the_view_cut_off():

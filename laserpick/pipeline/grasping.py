@@ -31,7 +31,12 @@ from laserpick.description.dims import (
     UR5_READY_Q,
     UR5_UNSTOW_Q,
 )
-from laserpick.pipeline.collision import CollisionChecker, carried_shape, mirrored_back
+from laserpick.pipeline.collision import (
+    CollisionChecker,
+    carried_shape,
+    mirrored_back,
+    object_middle,
+)
 from laserpick.pipeline.free_space import fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
@@ -103,6 +108,11 @@ class GraspSet:
         """The points (m, `base`) that stand for the target in the hand (`carried_shape`):
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
         return carried_shape(self.target, self.stands_on)
+
+    @functools.cached_property
+    def middle(self) -> np.ndarray:
+        """The target's middle (m, `base`), which a place turns it about (`object_middle`)."""
+        return object_middle(self.target, self.carried)
 
 
 def vertical_grasp(
