@@ -1,13 +1,31 @@
-"""The free-space test: a point is free where a camera saw past it. Depth images rendered
-here by casting each pixel's ray at a box on a table, so where the box hides space is known
-exactly."""
+"""The free-space test: a point is free where a camera saw past it; and what a camera's view
+cut off an object is carried on past its edge. Depth images rendered here by casting each
+pixel's ray at a box on a table, so where the box hides space is known exactly."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from laserpick.pipeline.free_space import finger_probes, fingers_seen_free, seen_free
-from laserpick.pipeline.types import DepthFrame, Grasp
+from laserpick.description import dims
+from laserpick.pipeline.collision import carried_shape
+from laserpick.pipeline.free_space import (
+    OBJECT_SPAN_MAX,
+    beyond_view,
+    finger_probes,
+    fingers_seen_free,
+    hidden,
+    seen_free,
+)
+from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.types import (
+    DepthFrame,
+    FusedCloud,
+    Grasp,
+    LaserMark,
+    Segmentation,
+    SupportSurface,
+)
 from laserpick.settings import GraspSettings
 
 TABLE = 0.46
@@ -33,18 +51,26 @@ def _looking_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
     return T
 
 
-def _frame(box: bool = True) -> DepthFrame:
-    """The box (if `box`) on the table seen from CAMERA: each pixel's depth along the optical
-    axis to the nearest of the box and the table plane."""
-    K, T = _intrinsics(), _looking_at(CAMERA, BOX_CENTRE)
+def _frame(
+    box: bool = True,
+    centre: np.ndarray = BOX_CENTRE,
+    half: np.ndarray = BOX_HALF,
+    look_at: np.ndarray | None = None,
+    f: float = 140.0,
+) -> DepthFrame:
+    """The box (if `box`; `centre`, `half` its extent, m) on the table seen from CAMERA,
+    looking at `look_at` (default: the box) with focal length `f` (px): each pixel's depth
+    along the optical axis to the nearest of the box and the table plane."""
+    K = _intrinsics(f=f)
+    T = _looking_at(CAMERA, centre if look_at is None else look_at)
     h, w = int(2 * K[1, 2]), int(2 * K[0, 2])
     v, u = np.mgrid[0:h, 0:w]
     rays_cam = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones((h, w))], -1)
     rays = rays_cam.reshape(-1, 3) @ T[:3, :3].T  # base; unit optical z component
     with np.errstate(divide="ignore", invalid="ignore"):
         t_table = np.where(rays[:, 2] < 0, (TABLE - CAMERA[2]) / rays[:, 2], np.inf)
-        lo = (BOX_CENTRE - BOX_HALF - CAMERA) / rays
-        hi = (BOX_CENTRE + BOX_HALF - CAMERA) / rays
+        lo = (centre - half - CAMERA) / rays
+        hi = (centre + half - CAMERA) / rays
     t_in = np.nanmax(np.minimum(lo, hi), axis=1)
     t_out = np.nanmin(np.maximum(lo, hi), axis=1)
     t_box = np.where(box & (t_in <= t_out) & (t_in > 0), t_in, np.inf)
@@ -97,3 +123,86 @@ def test_a_finger_in_the_box_unseen_back_is_refused_one_beside_it_is_not():
     assert fingers_seen_free([through], [], S).all()
     off = S.model_copy(update={"free_space_share": 0.0})
     assert fingers_seen_free([through], [frame], off).all()
+
+
+BAR_CENTRE = np.array([1.5, 0.0, TABLE + 0.03])
+BAR_HALF = np.array([0.03, 0.10, 0.03])  # a 6 x 20 x 6 cm bar lying across the view
+UP, FRONT = np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0])
+
+
+def _seen_surface(frame: DepthFrame, centre: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """What `frame` saw of the box at `centre` (`half` its extent, m): points on its top and
+    front faces, 5 mm apart, that project into the image and that no nearer reading hides."""
+    x, y, z = (np.arange(-h, h + 1e-9, 0.005) for h in half)
+    top = np.stack(np.meshgrid(x, y, [half[2]]), -1).reshape(-1, 3)
+    front = np.stack(np.meshgrid([-half[0]], y, z), -1).reshape(-1, 3)
+    faces = centre + np.vstack([top, front])
+    return faces[~hidden(faces, [frame], TOL)]
+
+
+def test_an_object_cut_off_by_the_view_is_carried_on_beyond_its_edge():
+    # The narrow camera looks 15 cm to the bar's left: its right edge cuts the bar's right
+    # end (-y) off, as the high camera's upper edge cut a lying juice bottle's.
+    cut = _frame(centre=BAR_CENTRE, half=BAR_HALF, look_at=BAR_CENTRE + [0, 0.15, -0.03], f=500)
+    seen = _seen_surface(cut, BAR_CENTRE, BAR_HALF)
+    far_end = BAR_CENTRE[1] - BAR_HALF[1]
+    assert seen[:, 1].min() > far_end + 0.03  # the camera saw no more than 17 of its 20 cm
+    more = beyond_view(seen, [cut], 0.02, TOL)
+    assert len(more)
+    # It goes on the way the view cut it off, to the longest object carried...
+    assert more[:, 1].max() < seen[:, 1].min() + 0.005
+    reach = seen[:, 1].max() - more[:, 1].min()
+    assert OBJECT_SPAN_MAX <= reach < OBJECT_SPAN_MAX + 0.02  # to within the 2 cm step
+    # ...only where no camera saw past...
+    assert not seen_free(more, [cut], TOL).any()
+    # ...and at the height the bar was seen at its cut.
+    assert more[:, 2].min() > BAR_CENTRE[2] - BAR_HALF[2] - 0.01
+    assert more[:, 2].max() < BAR_CENTRE[2] + BAR_HALF[2] + 0.01
+    # The carried shape then spans the bar's whole length, where from what was seen alone
+    # it spans that.
+    assert carried_shape(np.vstack([seen, more]), TABLE)[:, 1].min() < far_end
+    assert carried_shape(seen, TABLE)[:, 1].min() > far_end + 0.02
+    # A view from elsewhere that saw the table past the bar's end ends it there.
+    whole = _frame(centre=BAR_CENTRE, half=BAR_HALF)
+    ended = beyond_view(seen, [cut], 0.02, TOL, TABLE, others=[whole])
+    assert far_end - 0.02 < ended[:, 1].min() < far_end + 0.02
+
+
+def test_an_object_seen_whole_is_not_carried_on():
+    whole = _frame(centre=BAR_CENTRE, half=BAR_HALF)
+    seen = _seen_surface(whole, BAR_CENTRE, BAR_HALF)
+    assert seen[:, 1].min() < BAR_CENTRE[1] - BAR_HALF[1] + 0.005
+    assert len(beyond_view(seen, [whole], 0.02, TOL)) == 0
+    # Cut off in one camera's view, but seen whole in another's: not cut off.
+    cut = _frame(centre=BAR_CENTRE, half=BAR_HALF, look_at=BAR_CENTRE + [0, 0.15, -0.03], f=500)
+    assert len(beyond_view(seen, [cut, whole], 0.02, TOL)) == 0
+
+
+def test_find_grasps_carries_a_target_the_view_cut_off_on_past_its_edge():
+    cut = _frame(centre=BAR_CENTRE, half=BAR_HALF, look_at=BAR_CENTRE + [0, 0.15, -0.03], f=500)
+    bar = _seen_surface(cut, BAR_CENTRE, BAR_HALF)
+    bar_normals = np.where((bar[:, 2] > BAR_CENTRE[2] + BAR_HALF[2] - 1e-9)[:, None], UP, FRONT)
+    x, y = np.meshgrid(np.arange(1.2, 1.8, 0.006), np.arange(-0.3, 0.3, 0.006))
+    table = np.c_[x.ravel(), y.ravel(), np.full(x.size, TABLE)]
+    table = table[~hidden(table, [cut], TOL)]
+    n = len(bar) + len(table)
+    cloud = FusedCloud(
+        np.vstack([bar, table]).astype(np.float32),
+        np.vstack([bar_normals, np.tile(UP, (len(table), 1))]).astype(np.float32),
+        np.zeros(n, np.uint8),
+        np.arange(n, dtype=np.int32),
+        ("front",),
+    )
+    surface = SupportSurface(TABLE, np.array([0.0, 0.0, 1.0, -TABLE]))
+    seg = Segmentation(np.arange(len(bar)), "cluster", surface)
+    mark = LaserMark(bar[np.argmax(bar[:, 2])], "confirmed", 0, "direct")
+    far_end = BAR_CENTRE[1] - BAR_HALF[1]
+    found = find_grasps(Perception(cloud, mark, seg, None, frames=(cut,)), dims.UR5_READY_Q)
+    assert isinstance(found, GraspSet), found
+    assert found.cut_off[:, 1].min() < far_end
+    assert found.cut_off[:, 2].min() > TABLE  # none on the table it stands on
+    assert found.carried[:, 1].min() < far_end
+    # Without the frames it was seen in, nothing says the view cut it off.
+    alone = find_grasps(Perception(cloud, mark, seg, None), dims.UR5_READY_Q)
+    assert isinstance(alone, GraspSet) and len(alone.cut_off) == 0
+    assert alone.carried[:, 1].min() > far_end + 0.02

@@ -219,8 +219,9 @@ def carried_shape(
     target: np.ndarray, support: float | None = None, voxel: float = CARRIED_VOXEL
 ) -> np.ndarray:
     """The points (m, `base`) that stand for an object the hand is about to carry: what the
-    cameras saw of it, mirrored through the vertical axis of its top, and reaching down to
-    the surface it stands on.
+    cameras saw of it (and, where their view cut it off, what stands for the rest:
+    `beyond_view`), mirrored through the vertical axis of its top, and reaching down to the
+    surface it stands on.
 
     The cameras see an object from the front and above only, so its back half, and near a
     table's edge its lower part, are missing from `target` (N, 3); a carry planned around

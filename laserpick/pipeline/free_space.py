@@ -27,6 +27,16 @@ PROBE_ACROSS = (-0.6, 0.0, 0.6)
 PROBE_DOWN = (0.15, 0.5, 0.85)
 #: Nearest a probe may be to a camera (m) to count: the sensors' minimum range.
 MIN_RANGE = 0.1
+#: How near (px) to its image's border a target point projects for that camera's view to
+#: end there. The fused cloud keeps every second pixel and none on the border, so the last
+#: points lie 2-4 px in: a lying juice bottle on the 108 cm table ended 4 px inside the high
+#: camera's right edge, its other 12 cm beyond it.
+VIEW_EDGE_PX = 8
+#: Fewest target points at the view's edge for the object to count as cut off by it.
+CUT_MIN_POINTS = 5
+#: The longest (m) an object the hand carries is taken to be where the cameras' view cut it
+#: off (the kitchen's longest, the juice bottle, is 20.6 cm).
+OBJECT_SPAN_MAX = 0.25
 
 
 def _readings(
@@ -66,6 +76,62 @@ def hidden(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -
     for i, reading, z in _readings(points, frames):
         known[i[(reading > 0) & (reading >= z - tolerance)]] = True
     return ~known
+
+
+def beyond_view(
+    target: np.ndarray,
+    frames: Sequence[DepthFrame],
+    step: float,
+    tolerance: float,
+    support: float | None = None,
+    others: Sequence[DepthFrame] = (),
+) -> np.ndarray:
+    """Points (m, `base`) that stand for the part of an object the cameras' view cut off: none
+    when no part of it lies at the view's edge.
+
+    target (N, 3), `base`: what the cameras saw of the object in `frames`. A point lies at
+    the view's edge when it projects within VIEW_EDGE_PX of the border of some frame's
+    image and well inside none. The object may go on beyond: a lying juice bottle on the
+    108 cm table was seen 7.5 cm of its 20.6, and its unseen end, which no plan knew of, met
+    that table as the arm tucked it in (164 N).
+
+    So the edge points are carried on, `step` (m) at a time, away from the seen part's
+    middle, until the object spans OBJECT_SPAN_MAX that way. The way is level: what stands
+    or lies on a surface goes on along it, and the edge's own slant says little (the
+    bottle's top ran farther into the view than its side, which tilted the way 37 degrees
+    up). A copy some camera saw past (by `tolerance`, m), of `frames` or of `others` (views
+    from elsewhere), is left out: the object is not there. So is one within `tolerance` of
+    the `support` height (m) it stands on: no camera sees past a surface, and the carried
+    shape reaches down to it anyway (`carried_shape`).
+    """
+    target = np.asarray(target, np.float64).reshape(-1, 3)
+    near_edge = np.zeros(len(target), bool)
+    inside = np.zeros(len(target), bool)
+    for f in frames:
+        uv, _, ahead = pinhole_project(target, f.K, f.T_base_cam, MIN_RANGE)
+        h, w = f.depth.shape
+        inner = ahead & (uv >= VIEW_EDGE_PX).all(axis=1)
+        inner &= (uv[:, 0] < w - VIEW_EDGE_PX) & (uv[:, 1] < h - VIEW_EDGE_PX)
+        seen = ahead & (uv >= 0).all(axis=1) & (uv[:, 0] < w) & (uv[:, 1] < h)
+        near_edge |= seen & ~inner
+        inside |= inner
+    edge = target[near_edge & ~inside]
+    if len(edge) < CUT_MIN_POINTS:
+        return np.zeros((0, 3))
+    way = edge.mean(axis=0) - target.mean(axis=0)
+    way[2] = 0.0
+    if np.linalg.norm(way) < 1e-3:  # cut off above or below: no level way on
+        return np.zeros((0, 3))
+    way /= np.linalg.norm(way)
+    along = target @ way
+    reach = OBJECT_SPAN_MAX - float(along.max() - along.min())
+    steps = np.arange(1, int(np.ceil(reach / step)) + 1)[:, None, None] * step
+    copies = (edge[None] + steps * way).reshape(-1, 3)
+    if not len(copies):
+        return copies
+    if support is not None:
+        copies = copies[copies[:, 2] > support + tolerance]
+    return copies[~seen_free(copies, [*frames, *others], tolerance)]
 
 
 def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:

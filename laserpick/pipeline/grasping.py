@@ -32,12 +32,14 @@ from laserpick.description.dims import (
     UR5_UNSTOW_Q,
 )
 from laserpick.pipeline.collision import (
+    CARRIED_VOXEL,
+    SEEN_TOLERANCE,
     CollisionChecker,
     carried_shape,
     mirrored_back,
     object_middle,
 )
-from laserpick.pipeline.free_space import fingers_seen_free
+from laserpick.pipeline.free_space import beyond_view, fingers_seen_free
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
@@ -76,7 +78,8 @@ class GraspSet:
     clusters: the reachable grasps, scored and clustered, best first. rejected: the
     candidates the filter dropped, each with its `ik_failure`. world: collision model of the
     whole cloud; surroundings: of the cloud without the target (the hand may touch it).
-    timings: seconds per stage: "detect", "filter", "select".
+    timings: seconds per stage: "detect", "filter", "select". cut_off: points (m, `base`)
+    that stand for the part of the target the cameras' view cut off (`beyond_view`).
     """
 
     clusters: GraspClusters
@@ -88,6 +91,7 @@ class GraspSet:
     timings: dict[str, float] = field(default_factory=dict)
     #: Height (m, `base`) of the surface the target stands on; None when none was found.
     support: float | None = None
+    cut_off: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def ordered(self) -> list[Grasp]:
         """Every reachable grasp, best cluster first and best first within each (004's order
@@ -107,12 +111,18 @@ class GraspSet:
     def carried(self) -> np.ndarray:
         """The points (m, `base`) that stand for the target in the hand (`carried_shape`):
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
+        return carried_shape(np.vstack([self.target, self.cut_off]), self.stands_on)
+
+    @functools.cached_property
+    def carried_as_seen(self) -> np.ndarray:
+        """`carried` without `cut_off`: the target as the cameras saw it (m, `base`)."""
         return carried_shape(self.target, self.stands_on)
 
     @functools.cached_property
     def middle(self) -> np.ndarray:
-        """The target's middle (m, `base`), which a place turns it about (`object_middle`)."""
-        return object_middle(self.target, self.carried)
+        """The target's middle (m, `base`), which a place turns it about (`object_middle`), as
+        the cameras saw it: not the part `cut_off` stands in for."""
+        return object_middle(self.target, self.carried_as_seen)
 
 
 def vertical_grasp(
@@ -263,11 +273,14 @@ def find_grasps(
     t0 = time.perf_counter()
     recalled = recalled or Recalled()
     support = seg.surface.height if seg.surface is not None else None
+    cut_off = beyond_view(
+        target, perception.frames, CARRIED_VOXEL, SEEN_TOLERANCE, support, recalled.frames
+    )
     blind = recalled.points
     if len(blind):
         # The views saw the target from elsewhere: what they saw of it that is hidden now
         # is the target, not an obstacle beside it. Its extent is the carry's model of it.
-        whole = carried_shape(target, support, voxel=TARGET_VOXEL)
+        whole = carried_shape(np.vstack([target, cut_off]), support, voxel=TARGET_VOXEL)
         blind = recalled.blind_points(perception.frames, whole, support)
     world, surroundings = CollisionChecker.world_and_surroundings(
         np.vstack([cloud.points, blind]) if len(blind) else cloud.points,
@@ -332,7 +345,9 @@ def find_grasps(
     scored = [score(g, q_now=q_ref, sample=target, mark=mark, settings=s.grasp) for g in ok]
     clusters = group(scored, s.grasp)
     timings["select"] = time.perf_counter() - t0
-    return GraspSet(clusters, rejected, world, surroundings, target, strategy, timings, support)
+    return GraspSet(
+        clusters, rejected, world, surroundings, target, strategy, timings, support, cut_off
+    )
 
 
 def plan_first(
