@@ -7,6 +7,7 @@ import dataclasses
 import itertools
 import json
 import math
+import platform
 import subprocess
 import sys
 import time
@@ -305,8 +306,14 @@ def test_bench_command_on_a_user_mesh_scene(tmp_path: Path) -> None:
     assert {r["model"] for r in result["records"]} <= scene_models
     assert sum(result["failures"].values()) == sum(not r["success"] for r in result["records"])
     assert set(result["timings_s"]) >= {"acquire_cloud", "detect_laser", "attempt_total"}
+    # The packages the outcomes depend on, as the run found them installed.
+    env = result["environment"]
+    assert env["packages"]["mujoco"] == mujoco.__version__
+    assert env["packages"]["numpy"] == np.__version__
+    assert env["python"] == platform.python_version() and env["cpu"]
     report = out.with_suffix(".md").read_text()
     assert "isolation" in report and "93.8" in report  # ours beside 004's figure
+    assert f"mujoco {mujoco.__version__}" in report
     pngs = sorted(tmp_path.glob("user*.png"))
     assert len(pngs) == 2
     for png in pngs:

@@ -254,6 +254,10 @@ def _header(result: dict[str, Any], ref: Reference) -> list[str]:
         f"laserpick {result.get('version', '?')}; "
         f"created {result.get('created', '?')}.",
     ]
+    env = result.get("environment")
+    if env:  # runs before the record was kept have none
+        packages = ", ".join(f"{k} {v}" for k, v in env["packages"].items() if v)
+        lines += ["", f"Python {env['python']}; {packages}; CPU: {env['cpu']}."]
     for error in result.get("errors") or []:
         lines += [
             "",

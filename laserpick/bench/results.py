@@ -11,12 +11,43 @@ Rates (0-1):
 
 from __future__ import annotations
 
+import platform
 import statistics
 from collections.abc import Iterable, Sequence
 from datetime import UTC, datetime
+from importlib import metadata
 from typing import Any
 
 from laserpick.bench import FAILURE_KINDS, STAGES
+
+#: The packages whose versions a run's outcomes depend on: the simulation's contacts, the
+#: cloud's geometry and the solvers'. Within pyproject.toml's ranges another version moves
+#: single attempts (`selection`'s trial 5 mug, held in one `.venv` and dropped in the next).
+RESULT_PACKAGES = ("mujoco", "numpy", "scipy", "open3d", "mink", "pin", "ur-analytic-ik")
+
+
+def environment() -> dict[str, Any]:
+    """What a run's outcomes depend on besides the code and the seed: Python's version, each
+    of RESULT_PACKAGES' installed versions (None when missing) and the CPU's model name."""
+    packages: dict[str, str | None] = {}
+    for name in RESULT_PACKAGES:
+        try:
+            packages[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            packages[name] = None
+    return {"python": platform.python_version(), "packages": packages, "cpu": _cpu_model()}
+
+
+def _cpu_model() -> str:
+    """The CPU's model name (Linux's /proc/cpuinfo; else what `platform` knows)."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
 
 
 def _rate(k: int, n: int) -> float:
@@ -111,6 +142,7 @@ def result(
     out["records"] = records
     out["wall_time_s"] = round(wall_time_s, 1)
     out["version"] = __version__
+    out["environment"] = environment()
     out["created"] = datetime.now(UTC).isoformat(timespec="seconds")
     return out
 
