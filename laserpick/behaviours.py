@@ -198,14 +198,20 @@ class Held:
         """The object's points (m, `base`) with the TCP at pose T_tcp (4, 4), `base`."""
         return self.points_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
 
+    @property
+    def as_seen_tcp(self) -> np.ndarray:
+        """The object's points in the TCP frame (m) less what stood in for a part the view
+        cut off: where it will be once let go. The part guessed for a carry's safety is no
+        part of where it stands or falls."""
+        return self.points_tcp if self.seen_tcp is None else self.seen_tcp
+
     def standing_at(self, T_tcp: np.ndarray) -> np.ndarray:
         """The object as it stands once let go with the TCP at pose T_tcp (4, 4), `base`
-        (m, `base`): its points, less what stood in for a part the view cut off. The part
-        guessed for a carry's safety is space the open hand must not be kept out of: a juice
-        bottle and two pill bottles, set down with it taken for part of them, were no longer
-        on their spots once the hand had gone; set down as seen, they stood."""
-        pts = self.points_tcp if self.seen_tcp is None else self.seen_tcp
-        return pts @ T_tcp[:3, :3].T + T_tcp[:3, 3]
+        (m, `base`): `as_seen_tcp` there. The part guessed for a carry's safety is space the
+        open hand must not be kept out of: a juice bottle and two pill bottles, set down with
+        it taken for part of them, were no longer on their spots once the hand had gone; set
+        down as seen, they stood."""
+        return self.as_seen_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
 
 
 def front_wall(points: np.ndarray, height: float) -> np.ndarray:
@@ -655,12 +661,22 @@ class Behaviours:
     # --- drop and place -------------------------------------------------------------------
 
     def drop_configurations(
-        self, q_ref: np.ndarray, checker: CollisionChecker, payload: np.ndarray
+        self,
+        q_ref: np.ndarray,
+        checker: CollisionChecker,
+        payload: np.ndarray,
+        falls: np.ndarray | None = None,
     ) -> list[np.ndarray]:
         """Clear joint configurations that hold the object over the basket's opening, best
         first (rad): those of `drop_candidates()`, and where fewer than DROP_TRIES of them
         hold the whole object inside, the tilted ones after them (a cereal box held at its
         top fitted inside from one upright posture only, which no path reached).
+
+        payload (P, 3), TCP frame (m): the points kept clear of everything, as carried.
+        falls (F, 3), TCP frame (m): the object as it falls when let go (default `payload`):
+        less the part that stands in for what the view cut off (`Held.as_seen_tcp`), which
+        would pull the middle it is held by off the real object's (in-situ lost a juice
+        bottle and a cereal box beside the basket that way).
 
         Postures that hold every point of the object inside the opening (1 cm in from the
         walls) come first, upright before tilted, each by the shortest fall (in FALL_STEP
@@ -672,9 +688,11 @@ class Behaviours:
         The basket sits close beside the arm's base, between the tiller, the sensor posts and
         the projector, so few postures reach over it: they are searched, not assumed.
         """
-        ranked = self._rank_drops(drop_candidates(), q_ref, checker, payload)
+        falls = payload if falls is None else falls
+        ranked = self._rank_drops(drop_candidates(), q_ref, checker, payload, falls)
         if sum(key[0] == 0 for key, _ in ranked) < DROP_TRIES:
-            ranked += self._rank_drops(drop_candidates(tilted=True), q_ref, checker, payload)
+            tilted = drop_candidates(tilted=True)
+            ranked += self._rank_drops(tilted, q_ref, checker, payload, falls)
             inside = [kq for kq in ranked if kq[0][0] == 0]
             past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
             ranked = inside + past
@@ -686,15 +704,16 @@ class Behaviours:
         q_ref: np.ndarray,
         checker: CollisionChecker,
         payload: np.ndarray,
+        falls: np.ndarray,
     ) -> list[tuple[tuple[int, int, int, int, float], np.ndarray]]:
-        """The clear `candidates` that hold the object's middle over the opening, each with
-        its rank key (see `drop_configurations`), sorted."""
+        """The clear `candidates` (clear with `payload`) that hold the object's middle over
+        the opening, each with its rank key (see `drop_configurations`; of `falls`), sorted."""
         if not candidates:
             return []
         floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
         Q = np.array(candidates)
         T = tcp_pose(Q)
-        pts = payload if len(payload) else np.zeros((1, 3))
+        pts = falls if len(falls) else np.zeros((1, 3))
         held = held_at(T, pts)  # (B, P, 3)
         middle_in = past_the_opening(held.mean(axis=1)) == 0
         Q, held = Q[middle_in], held[middle_in]
@@ -827,7 +846,9 @@ class Behaviours:
             self.held = None
             return Outcome(Failure("precondition", "The hand is not holding anything."))
         held = self.held
-        drops = self.drop_configurations(self._q(), held.surroundings, held.points_tcp)
+        drops = self.drop_configurations(
+            self._q(), held.surroundings, held.points_tcp, held.as_seen_tcp
+        )
         if not drops:
             msg = "The arm cannot hold the object over the basket; it keeps it."
             return Outcome(Failure("ik_plan", msg))
@@ -859,7 +880,7 @@ class Behaviours:
         # out of the basket, and a straight way to ready swept the fingers through it (152 N,
         # a protective stop). The object can only have fallen from where the hand let go.
         T = tcp_pose(self._q())
-        let_go = held.at(T)
+        let_go = held.standing_at(T)
         caution = PAST_THE_OPENING if past_the_opening(let_go).any() else None
 
         def said(out: Outcome) -> Outcome:
