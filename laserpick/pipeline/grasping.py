@@ -115,7 +115,11 @@ class GraspSet:
 
     @functools.cached_property
     def carried_as_seen(self) -> np.ndarray:
-        """`carried` without `cut_off`: the target as the cameras saw it (m, `base`)."""
+        """`carried` without `cut_off`: the target as the cameras saw it (m, `base`). The
+        same points as `carried` where the view cut nothing off (most targets), so not
+        worked out twice then."""
+        if not len(self.cut_off):
+            return self.carried
         return carried_shape(self.target, self.stands_on)
 
     @functools.cached_property
