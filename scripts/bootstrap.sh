@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Idempotent setup: Debian libraries where missing, then `.venv` with `pip install -e '.[dev]'`.
-# Re-running is cheap: pip is only called again when pyproject.toml changes.
+# Idempotent setup: Debian libraries where missing, then `.venv` with `pip install -e '.[dev]'`,
+# the packages the figures depend on pinned by constraints.txt. Re-running is cheap: pip is only
+# called again when pyproject.toml or constraints.txt changes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,10 +28,10 @@ if [ ! -x .venv/bin/python ]; then
 fi
 
 stamp=.venv/.laserpick-installed
-want=$(sha256sum pyproject.toml | cut -d' ' -f1)
+want=$(cat pyproject.toml constraints.txt | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
-    echo "bootstrap: pip install -e '.[dev]'"
+    echo "bootstrap: pip install -e '.[dev]' -c constraints.txt"
     .venv/bin/python -m pip install -q --upgrade pip
-    .venv/bin/python -m pip install -q -e '.[dev]'
+    .venv/bin/python -m pip install -q -e '.[dev]' -c constraints.txt
     echo "$want" > "$stamp"
 fi

@@ -68,7 +68,7 @@ from laserpick.bench.protocols import (
     set_down_error,
 )
 from laserpick.bench.report import markdown
-from laserpick.bench.results import outcomes, summarize
+from laserpick.bench.results import RESULT_PACKAGES, environment, outcomes, summarize
 from laserpick.bench.runner import run
 from laserpick.bench.truth import capture
 from laserpick.description import dims
@@ -320,6 +320,18 @@ def test_bench_command_on_a_user_mesh_scene(tmp_path: Path) -> None:
         with Image.open(png) as im:
             assert im.width >= 600 and len(im.getcolors(1 << 20) or []) > 2
     assert "isolation" in done.stderr  # the progress bar
+
+
+def test_the_packages_a_result_records_are_the_ones_bootstrap_pins() -> None:
+    """constraints.txt pins each package a bench result records, exactly, and `make
+    bootstrap` installed those versions: the figures replay in this environment."""
+    pins = {}
+    for line in (Path(__file__).parents[1] / "constraints.txt").read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            name, version = line.split("==")
+            pins[name.strip()] = version.strip()
+    assert sorted(pins) == sorted(RESULT_PACKAGES)
+    assert environment()["packages"] == pins
 
 
 def test_bench_command_refuses_a_broken_scene(tmp_path: Path) -> None:
