@@ -463,8 +463,9 @@ def _still_there(op: ScriptedOperator, name: str, stood: np.ndarray) -> bool:
 
 def coin_flip_kitchen(rng: np.random.Generator) -> Scene:
     """The `kitchen` scene with each object upright or on its side by a coin flip. An object
-    that does not fit its spot on its side (a cereal box lying on a shelf's edge) stands
-    upright instead, as the experimenter would set it."""
+    that does not fit its spot on its side (a cereal box lying on a shelf's edge), or does
+    not rest on its side (a banana's curve tips it over, `objects.at_rest`), stands upright
+    instead, as the experimenter would set it."""
     config = scene_config("kitchen")
     objects = config["objects"]
     for obj in objects:

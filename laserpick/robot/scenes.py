@@ -44,7 +44,9 @@ Objects rest on the top of their surface (or the given shelf level, the top one 
 they last; `any` is every opaque library object that fits), a yaw, and for `coin_flip` an
 upright or lying pose, and place them by rejection sampling so that footprint circles keep
 `min_gap` from each other and `margin` from the surface edges (or stay inside `region`, given
-in the surface's local frame as [xmin, xmax, ymin, ymax]).
+in the surface's local frame as [xmin, xmax, ymin, ymax]). Lying is only for an object that
+rests on its side (`objects.at_rest`): a banana's curve tips it over, so `lying: true` on a
+banana is an error, and a coin flip stands it upright.
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ from laserpick.robot.objects import (
     OpticalKind,
     Part,
     add_object_body,
+    at_rest,
     footprint_half_extents,
     opaque_names,
     quat_mul,
@@ -674,6 +677,12 @@ class _Builder:
                 surf = self.surface(oc.on, f"{path}.on")
                 xy = np.array(oc.xy, dtype=float)
             level = self.level(surf, level_in, f"{path}.level")
+            if oc.lying and not at_rest(model, lying=True):
+                raise self.fail(
+                    f"{path}.lying",
+                    f"{oc.model!r} does not rest on its side: laid so, it tips over at a touch;"
+                    " stand it upright",
+                )
             placed = self._pose(model, surf, level, xy, math.radians(oc.yaw_deg), oc.lying)
             self._check_fits(placed, surf, level, path, oc.model)
             for other in self.placed:
@@ -777,8 +786,10 @@ class _Builder:
             picks = rng.choice(len(pool), size=rc.count, replace=rc.count > len(pool))
             poses = []
             for k in picks:
-                lying = bool(rc.orientation == "coin_flip" and rng.random() < 0.5)
+                heads = rc.orientation == "coin_flip" and rng.random() < 0.5
                 model = pool[int(k)]
+                # Heads lays it on its side only where it rests so (`at_rest`).
+                lying = bool(heads) and at_rest(model, lying=True)
                 r = rest_pose(model, lying).radius
                 if x1 - x0 < 2 * r or y1 - y0 < 2 * r:
                     raise self.fail(
