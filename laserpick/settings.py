@@ -457,6 +457,22 @@ class GraspSettings(BaseModel):
     gpd_min_contacts: int = Field(
         6, ge=1, description="Antipodal contact points needed on each side. GPD's min_viable."
     )
+    gpd_tangent_deg: float = Field(
+        10.0,
+        gt=0,
+        lt=90,
+        description="A pad meets the object along its face where the object's normals at the"
+        " pad's extreme lie within this angle (deg) of the closing axis"
+        " (grasp_detect.closing_region). Ours.",
+    )
+    gpd_patch_offset: float = Field(
+        0.007,
+        ge=0,
+        description="How far (m) along the hand axis the middle of the patch where a pad meets"
+        " the object may lie from the pad's middle for the grasp to count as centred"
+        " (grasp_detect.closing_region), and be offered before those that do not"
+        " (selection.group): a pad that meets it only at its edge lets it spin out. Ours.",
+    )
     gpd_collision_voxel: float = Field(
         0.0,
         ge=0,

@@ -169,6 +169,24 @@ def test_cylinder_gets_top_and_side_grasps(cylinder_grasps):
     assert (np.abs(approach_z) < 0.3).sum() >= 3  # from the side
 
 
+def test_a_can_from_above_is_centred_only_where_its_pads_meet_it_about_their_middle():
+    """From above, the pads meet a can's side along the line through its axis. GPD's friction
+    cone alone passes a hand tilted up to 20 degrees and shifted along the hand axis until
+    that line lies at the pads' edge or past it (up to 15 mm on this can): such a pad meets
+    the can with a corner. A grasp is `pads_centred` only where each pad meets it along its
+    face (gpd_tangent_deg), about its middle (gpd_patch_offset)."""
+    pts, n = cylinder(r=0.033, height=0.122)
+    from_above = [g for g in detect(pts, n) if g.approach[2] < -0.7]
+    # How far along the hand axis the can's axis passes from the TCP (m).
+    off = np.array(
+        [abs(np.array([-g.position[0], -g.position[1], 0.0]) @ g.axis) for g in from_above]
+    )
+    centred = np.array([g.pads_centred for g in from_above])
+    assert centred.sum() >= 20
+    assert off[centred].max() <= S.gpd_patch_offset
+    assert off[~centred].max() > 2 * S.gpd_patch_offset
+
+
 def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():
     rng = np.random.default_rng(4)
     normal = rng.normal(size=(5, 3))
@@ -416,15 +434,15 @@ def test_antipodal_possible_never_rules_out_a_passing_frame():
     pts, n = cylinder()
     normals = noisy(n)
     samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, _, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
+    sid, _, h, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
     possible = gd.antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
     rng = np.random.default_rng(3)
     passed = np.zeros(len(possible), bool)
     for _ in range(30):  # any placement, any depth the collision test could give
         offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
         tip = rng.uniform(S.gpd_init_bite, S.finger_length - S.gpd_clearance, len(possible))
-        _, ok = gd.closing_region(
-            u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
+        _, ok, _ = gd.closing_region(
+            h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
         )
         passed |= ok
     assert passed.sum() > 50 and not possible.all()
@@ -480,8 +498,10 @@ def test_detector_equals_the_direct_computation():
     has, k = gd.middle_placement(np.isfinite(tips))
     offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
     tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, _, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
-    width, ok = gd.closing_region(tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s)
+    tsid, _, th, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
+    width, ok, centred = gd.closing_region(
+        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s
+    )
     good = np.flatnonzero(ok & has)
     poses = gd.grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
     poses[:, :3, 3] += centre
@@ -489,3 +509,4 @@ def test_detector_equals_the_direct_computation():
     assert len(fast) == len(good) > 50
     np.testing.assert_allclose([g.pose for g in fast], poses, rtol=0, atol=1e-6)
     np.testing.assert_allclose([g.width for g in fast], width[good], rtol=0, atol=1e-6)
+    assert [g.pads_centred for g in fast] == centred[good].tolist()

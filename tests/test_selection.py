@@ -4,6 +4,7 @@ bound, and stepping through clusters."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -170,3 +171,18 @@ def test_group_orders_clusters_and_candidates_by_score_and_the_cursor_steps():
         cur.select(3)
     with pytest.raises(ValueError):
         sel.GraspCursor(sel.group([]))
+
+
+def test_group_offers_grasps_whose_pads_meet_the_object_off_their_middle_last():
+    """Within a cluster and across clusters, a grasp whose pads meet the object toward their
+    edge (`pads_centred` False) comes after every centred one, whatever its score."""
+    grasps = [
+        replace(_scored((1.5, 0.0, 0.5), 0.9), pads_centred=False),
+        _scored((1.5, 0.005, 0.5), 0.6),  # same cluster as the first: centred, worse
+        replace(_scored((1.6, 0.0, 0.5), 0.95), pads_centred=False),  # its own cluster
+        _scored((1.7, 0.0, 0.5), 0.5),  # its own cluster, centred
+    ]
+    groups = sel.group(grasps)
+    order = [groups.grasps[i] for m in groups.clusters for i in m]
+    assert [round(g.score, 2) for g in order] == [0.6, 0.9, 0.5, 0.95]
+    assert groups.best is not None and groups.best.score == pytest.approx(0.6)

@@ -106,7 +106,8 @@ def cluster_positions(positions: np.ndarray, max_distance: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class GraspClusters:
-    """Scored grasps grouped by position, best cluster first, best grasp first within each.
+    """Scored grasps grouped by position, best cluster first, best grasp first within each
+    (`group` says what best is).
 
     clusters[i] lists indices into `grasps`.
     """
@@ -120,7 +121,14 @@ class GraspClusters:
 
 
 def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> GraspClusters:
-    """Cluster grasps by position (004 section 7.2) and order everything by score."""
+    """Cluster grasps by position (004 section 7.2) and order everything by score, those
+    whose pads meet the object about their middle first (`Grasp.pads_centred`): the grasps
+    in each cluster, and the clusters by their first grasp.
+
+    Ours: 004 orders by score alone. But C does not see where along the pads the object
+    lies, and a can met only toward the pads' edges spins out of the hand when the scooter
+    turns (seed 1's soda can, stop 57). Such a grasp is still offered, after the others:
+    it is often the only one an object has."""
     s = settings or get_settings().grasp
     if not grasps:
         return GraspClusters((), ())
@@ -128,8 +136,12 @@ def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> Gra
     members: dict[int, list[int]] = {}
     for i, label in enumerate(labels):
         members.setdefault(int(label), []).append(i)
-    ordered = [sorted(m, key=lambda i: -grasps[i].score) for m in members.values()]
-    ordered.sort(key=lambda m: -grasps[m[0]].score)
+
+    def rank(i: int) -> tuple[bool, float]:
+        return not grasps[i].pads_centred, -grasps[i].score
+
+    ordered = [sorted(m, key=rank) for m in members.values()]
+    ordered.sort(key=lambda m: rank(m[0]))
     tagged = list(grasps)
     for c, m in enumerate(ordered):
         for i in m:

@@ -163,6 +163,9 @@ class Grasp:
     scores: the selection factors, once scored.
     cluster: index of the position cluster for manual selection (-1 before clustering).
     ik: the chosen joint solution (6,), or None with `ik_failure` saying why.
+    pads_centred: whether each pad meets the object along its face, about its middle
+    (`grasp_detect.closing_region`): False for a GPD candidate whose pad meets it only
+    toward an edge, offered after the others (`selection.group`).
     """
 
     pose: np.ndarray
@@ -171,6 +174,7 @@ class Grasp:
     cluster: int = -1
     ik: np.ndarray | None = None
     ik_failure: str | None = None
+    pads_centred: bool = True
 
     @property
     def position(self) -> np.ndarray:

@@ -182,7 +182,8 @@ def _vec(a: np.ndarray | None, digits: int = 4) -> list[float] | None:
 
 
 def grasp_summary(g: Grasp) -> dict[str, Any]:
-    """A grasp as JSON: pose (4x4, `base`), width (m), score and its five factors."""
+    """A grasp as JSON: pose (4x4, `base`), width (m), score and its five factors, and
+    whether its pads meet the object about their middle (such grasps are offered first)."""
     scores = g.scores
     return {
         "pose": [_vec(row) for row in g.pose],
@@ -194,6 +195,7 @@ def grasp_summary(g: Grasp) -> dict[str, Any]:
         if scores is None
         else {k: round(float(getattr(scores, k)), 4) for k in ("Cw", "Cj", "Ca", "Cs", "Cp")},
         "cluster": g.cluster,
+        "pads_centred": g.pads_centred,
     }
 
 

@@ -406,8 +406,10 @@ function renderGrasp(s) {
     const c = s.current;
     const f = c.factors
       ? " (" + Object.entries(c.factors).map(([k, v]) => `${k} ${v.toFixed(2)}`).join(", ") + ")" : "";
+    // A grasp whose pads meet the object toward their edge is offered after the others.
+    const edge = c.pads_centred === false ? " Its pads meet the object toward their edge." : "";
     const go = s.selection === "manual" ? "Go picks this grasp." : "Go picks the best grasp that plans.";
-    text = `Grasp: ${s.grasps.describe}. Score ${c.score.toFixed(2)}${f}. Opening ${Math.round(c.width * 1000)} mm. ${go}`;
+    text = `Grasp: ${s.grasps.describe}. Score ${c.score.toFixed(2)}${f}.${edge} Opening ${Math.round(c.width * 1000)} mm. ${go}`;
   }
   if ($("grasp-info").textContent !== text) $("grasp-info").textContent = text;
 }
