@@ -211,6 +211,10 @@ class GraspStatus(BaseModel):
     score: float
     factors: dict[str, float] | None = Field(description="Cw, Cj, Ca, Cs, Cp (004 eq. 3-7).")
     cluster: int
+    pads_centred: bool = Field(
+        description="Whether its pads meet the object along their face about their middle;"
+        " such grasps are offered first."
+    )
 
 
 class FailureStatus(BaseModel):
