@@ -602,8 +602,8 @@ def test_the_user_moves_a_place_mark_whose_dot_lands_on_something_in_front(
 
 
 def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) -> None:
-    """The robot cannot see a glass cup; the user can, and puts a plush toy lying on its
-    side (17 cm long) down only where all of it clears the cup, on the line of spots the
+    """The robot cannot see a glass cup; the user can, and puts a juice bottle lying on its
+    side (20.6 cm long) down only where all of it clears the cup, on the line of spots the
     cup stands on (25 cm behind the front edge). A pill bottle fits nearer."""
     scene = tmp_path / "cup.yaml"
     scene.write_text(
@@ -611,22 +611,22 @@ def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) 
         "surfaces:\n  - {name: t, kind: table, xy: [1.6, 0.0], size: [0.6, 1.2], height: 0.46}\n"
         "  - {name: f, kind: floor, xy: [0.0, 2.0], size: [1.0, 1.0]}\n"
         "objects:\n  - {name: cup, model: glass_cup, on: t, xy: [1.55, 0.0]}\n"
-        "  - {name: toy, model: stuffed_toy, on: f, xy: [0.0, 2.0], lying: true}\n"
+        "  - {name: bottle, model: juice_bottle, on: f, xy: [0.0, 2.0], lying: true}\n"
         "  - {name: pill, model: pill_bottle, on: f, xy: [0.3, 1.7]}\n"
     )
     loaded = load_scene(str(scene))
     with _operated(loaded, 0, 1, Options()) as op:
         cup = op.referee.object_points("cup", frame="world")[:, :2]
-        toy = op.referee.object_points("toy", frame="world")[:, :2]
-        reach = np.linalg.norm(toy - (toy.min(axis=0) + toy.max(axis=0)) / 2, axis=1).max()
-        assert reach > 0.08, "lying down, the toy reaches 8.7 cm from its middle"
-        room = room_for(op, "toy")
+        bottle = op.referee.object_points("bottle", frame="world")[:, :2]
+        reach = np.linalg.norm(bottle - (bottle.min(axis=0) + bottle.max(axis=0)) / 2, axis=1).max()
+        assert reach > 0.1, "lying down, the bottle reaches 10.3 cm from its middle"
+        room = room_for(op, "bottle")
         assert room > reach + 0.05 and room > room_for(op, "pill") + 0.04
         for _ in range(20):
-            found = free_spot(op, loaded.surface("t"), room, "toy")
+            found = free_spot(op, loaded.surface("t"), room, "bottle")
             assert found is not None
             gap = np.linalg.norm(cup - found[1][:2], axis=1).min()
-            assert gap > reach + 0.05, f"the toy would stand {gap - reach:.3f} m from the cup"
+            assert gap > reach + 0.05, f"the bottle would stand {gap - reach:.3f} m from the cup"
 
 
 def test_where_the_line_of_spots_is_full_the_user_sets_down_nearest_it(tmp_path: Path) -> None:
@@ -670,38 +670,38 @@ def test_where_the_line_of_spots_is_full_the_user_sets_down_nearest_it(tmp_path:
 
 def test_a_set_down_object_is_judged_by_where_it_stands(tmp_path: Path) -> None:
     """The bench judges a place by the middle of the object's footprint. A place turned about
-    the vertical turns the object about its middle: a plush toy lying on its side, turned 30
-    degrees so, rests where it was set down, though its origin (the middle of its seat, at
-    one end of it lying) moved 3 cm or more and was counted off the mark. A can standing
+    the vertical turns the object about its middle: a juice bottle lying on its side, turned
+    30 degrees so, rests where it was set down, though its origin (the middle of its bottom,
+    at one end of it lying) moved 3 cm or more and was counted off the mark. A can standing
     upright is judged by its origin, as before."""
-    scene = tmp_path / "toy.yaml"
+    scene = tmp_path / "bottle.yaml"
     scene.write_text(
-        "name: toy\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
+        "name: bottle\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
         "surfaces:\n  - {name: f, kind: floor, xy: [1.5, 0.0], size: [1.0, 1.0]}\n"
-        "objects:\n  - {name: toy, model: stuffed_toy, on: f, xy: [1.5, 0.2], lying: true}\n"
+        "objects:\n  - {name: bottle, model: juice_bottle, on: f, xy: [1.5, 0.2], lying: true}\n"
         "  - {name: can, model: soda_can, on: f, xy: [1.5, -0.2]}\n"
     )
     with _operated(load_scene(str(scene)), 0, 1, Options()) as op:
         ref = op.referee
         assert np.allclose(ref.footprint_middle("can"), 0.0, atol=1e-3)
-        anchor = ref.footprint_middle("toy")
+        anchor = ref.footprint_middle("bottle")
         assert np.linalg.norm(anchor) > 0.04, "lying, its origin is at one end"
-        stands, origin = ref.body_point("toy", anchor), ref.position("toy")
-        assert set_down_error(ref, "toy", anchor, stands, np.zeros(2)) < 1e-9
+        stands, origin = ref.body_point("bottle", anchor), ref.position("bottle")
+        assert set_down_error(ref, "bottle", anchor, stands, np.zeros(2)) < 1e-9
         middle = ref.to_world(stands)
         turn = rotz(math.radians(30.0))
 
         def turn_about_middle(m: mujoco.MjModel, d: mujoco.MjData) -> None:
-            adr = m.joint("obj/toy").qposadr[0]
+            adr = m.joint("obj/bottle").qposadr[0]
             pos, quat = d.qpos[adr : adr + 3].copy(), d.qpos[adr + 3 : adr + 7].copy()
             d.qpos[adr : adr + 3] = middle + turn @ (pos - middle)
             d.qpos[adr + 3 : adr + 7] = quat_from_matrix(turn @ matrix_from_quat(quat))
 
         op.robot.sim.call(turn_about_middle)
         op.robot.sleep(0.5)
-        moved = float(np.linalg.norm((ref.position("toy") - origin)[:2]))
+        moved = float(np.linalg.norm((ref.position("bottle") - origin)[:2]))
         assert moved > 0.03, f"its origin moved only {moved * 100:.1f} cm"
-        assert set_down_error(ref, "toy", anchor, stands, np.zeros(2)) < 0.005
+        assert set_down_error(ref, "bottle", anchor, stands, np.zeros(2)) < 0.005
 
 
 def test_the_user_watches_the_dot_of_a_place_mark_on_a_top_just_below_the_pointer(
@@ -759,7 +759,9 @@ def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_su
         return place(op, spot)
 
     monkeypatch.setattr(ScriptedOperator, "place", refusing)
-    (rec,) = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    *tries, rec = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    # The user picks again where a pick found no way to its grasp (at most 3 picks).
+    assert len(tries) < MAX_TRIES and all(t.failure == "ik_plan" for t in tries)
     assert rec.success, (rec.message, rec.places, rec.surface)
     assert rec.places == MAX_TRIES + 1, "three refused marks, then one on the other surface"
     here, to = rec.surface.split(" -> ")
@@ -790,9 +792,11 @@ def test_an_object_a_lost_task_leaves_in_the_hand_is_taken_away_not_dropped(
         after.append(op.referee.position("can"))
 
     monkeypatch.setattr(ScriptedOperator, "tidy", tidy_and_look)
-    (rec,) = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    *tries, rec = PROTOCOLS["pick-place"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    # The user picks again where a pick found no way to its grasp (at most 3 picks).
+    assert len(tries) < MAX_TRIES and all(t.failure == "ik_plan" for t in tries)
     assert rec.grasped and not rec.success and rec.places == MAX_TRIES, rec.message
-    assert np.linalg.norm(after[0][:2]) > 3.0, f"the can was left at {after[0]}"
+    assert np.linalg.norm(after[-1][:2]) > 3.0, f"the can was left at {after[-1]}"
 
 
 def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer_their_middle():
