@@ -382,9 +382,7 @@ def _at_rest_cached(model: ObjectModel, lying: bool) -> bool:
     rp = rest_pose(model, lying)
     up = matrix_from_quat(rp.quat)[2]  # the world's up in the object's frame
     for ax, ay in _REST_TIP_AXES:
-        q = np.zeros(4)
-        mujoco.mju_axisAngle2Quat(q, np.array([ax, ay, 0.0]), math.radians(REST_TIP_DEG))
-        mujoco.mju_mulQuat(q, q, rp.quat)
+        q = quat_mul(axis_angle_quat((ax, ay, 0.0), math.radians(REST_TIP_DEG)), rp.quat)
         spec = mujoco.MjSpec()
         spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
         spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[1.0, 1.0, 0.1])
