@@ -146,6 +146,24 @@ def test_stowed_and_ready_poses_are_clear_and_the_checker_sees_what_it_should():
         assert what in free.what_hits(Q[0])
 
 
+def test_the_clearance_a_posture_keeps_is_found_to_within_its_steps():
+    """A point 4 mm below the wrist's lowest sphere: the ready pose keeps 4 mm, less than
+    the 1 cm margin; clear of it, the margin; touching it, nothing."""
+    centres = sphere_centres(body_frames(dims.UR5_READY_Q))[0]
+    wrist = ~SPHERES.hand & (SPHERES.body >= 3)
+    lowest = np.flatnonzero(wrist)[np.argmin(centres[wrist, 2] - SPHERES.radius[wrist])]
+    below = centres[lowest] - [0.0, 0.0, SPHERES.radius[lowest] + 0.004]
+    checker = CollisionChecker(below[None], voxel=0.0, margin=0.01)
+    assert not checker.clearance_ok(dims.UR5_READY_Q, hand=False)[0]
+    kept = checker.clearance_kept(dims.UR5_READY_Q, hand=False)
+    assert kept == pytest.approx(0.004, abs=0.01 / 2**8)
+    assert checker.clearance_ok(dims.UR5_READY_Q, hand=False, margin=kept)[0]
+    far = CollisionChecker(below[None] - [0.0, 0.0, 0.05], voxel=0.0, margin=0.01)
+    assert far.clearance_kept(dims.UR5_READY_Q, hand=False) == 0.01
+    inside = CollisionChecker(below[None] + [0.0, 0.0, 0.01], voxel=0.0, margin=0.01)
+    assert inside.clearance_kept(dims.UR5_READY_Q, hand=False) is None
+
+
 def test_keepout_boxes_are_well_formed():
     for b in KEEPOUT_BOXES:
         assert np.all(np.array(b.lo) < np.array(b.hi)), b.name

@@ -156,6 +156,9 @@ CARRIED_PADDING = 0.03
 PAYLOAD_CLEAR_OF_BODY = 3
 #: A joint segment's every this-many-th configuration is checked before the rest.
 SEGMENT_COARSE = 8
+#: Halvings of the margin that find the clearance a configuration keeps (`clearance_kept`):
+#: 8 find a 1 cm margin's share to within 0.04 mm.
+CLEARANCE_STEPS = 8
 #: Space within this much (m) of where the arm's spheres were when the frames were captured,
 #: or of where the hand passes on the way out of the stowed pose, counts as seen.
 OWN_SPACE_PADDING = 0.02
@@ -478,6 +481,25 @@ class CollisionChecker:
             blind = self.unseen(spheres, np.tile(radius[out], len(rows)))
             clear[rows[blind.reshape(len(rows), -1).any(axis=1)]] = False
         return clear
+
+    def clearance_kept(
+        self, q: np.ndarray, *, hand: bool = True, steps: int = CLEARANCE_STEPS
+    ) -> float | None:
+        """The clearance (m) configuration q (6,) (rad) keeps from everything: the checker's
+        margin where it is clear, else the largest smaller margin at which it is (found by
+        halving, to within margin / 2**steps), None where it touches something (not clear
+        at no margin). A move out from where a place left the arm may keep this much, not
+        more: the forearm let down with an object onto the 31 cm table stood 4 mm above it."""
+        q = np.asarray(q, float)
+        if self.clearance_ok(q, hand=hand)[0]:
+            return self.margin
+        if not self.clearance_ok(q, hand=hand, margin=0.0)[0]:
+            return None
+        lo, hi = 0.0, self.margin
+        for _ in range(steps):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if self.clearance_ok(q, hand=hand, margin=mid)[0] else (lo, mid)
+        return lo
 
     def knowing(self, *Q: np.ndarray) -> CollisionChecker:
         """This checker, with the arm's spheres at configurations Q (6,) (rad) counted as seen
