@@ -781,9 +781,10 @@ class Behaviours:
         `hand`) clear of `checker`: straight, or, holding `payload`, reaching out RISE_OUT
         from the arm's mount where that brings the payload clear. None when neither does.
         Clear, where the arm starts within the checker's margin, means keeping at least the
-        clearance it starts with (`clearance_kept`): an object set down on the 31 cm table
-        left the forearm 4 mm above the top, and a rise held to the full margin could not
-        leave (2 of 195 pick-place tasks ended with the arm out over the table)."""
+        clearance it starts with (`clearance_kept`): cereal boxes set down on the 31 cm
+        table and the 87 cm counter left the forearm 2-4 mm above the top, and a rise held
+        to the full margin could not leave (2 of 195 pick-place tasks ended with the arm
+        out over the surface)."""
         q = self._q()
         kept = checker.clearance_kept(q, hand=hand)
         if kept is None:

@@ -580,7 +580,7 @@ def test_an_arm_let_down_within_the_margin_of_a_surface_rises_away_from_it(robot
     """A place may let the forearm down nearer a surface than the margin (it must only not
     reach into the support): set down on the 31 cm table, a cereal box left it 4 mm above
     the top, and a rise held to the full margin could not leave (2 of 195 pick-place tasks
-    ended with the arm out over the table). A patch of surface 4 mm under the middle of the
+    ended with the arm out over the surface). A patch of surface 4 mm under the middle of the
     forearm: the arm rises, keeping at least those 4 mm, and ends clear."""
     b = Behaviours(robot)
     assert b.go_ready().ok
