@@ -109,6 +109,20 @@ def test_place_moves_back_from_the_front_edge(surfaces):
         assert np.allclose(kept[:2], far[:2])
 
 
+def test_a_mark_on_the_floor_is_not_moved_back(surfaces):
+    """The floor has no edge to fall from: its nearest seen boundary is where the cameras'
+    view begins. A mark 3 cm past that stays where it is (moved back 10 cm from it, a cereal
+    box was set down 5 cm from its mark)."""
+    surf, cloud, y0 = next(s for s in surfaces if s[0].kind == "floor")
+    y = float(surf.xy[1]) - y0
+    pts = cloud.points
+    floor = pts[(np.abs(pts[:, 2]) < 0.01) & (np.abs(pts[:, 1] - y) < 0.05)]
+    mark = _mark_on(cloud, np.array([float(floor[:, 0].min()) + 0.03, y]), 0.0)
+    place = place_target(cloud, mark, SETTINGS)
+    assert not isinstance(place, Failure), place
+    assert np.allclose(place[:2], mark[:2])
+
+
 def test_place_off_a_surface_fails(surfaces):
     surf, cloud, y0 = next(s for s in surfaces if s[0].name == "s09")
     mark = _mark_on(cloud, np.array([1.6, surf.xy[1] - y0]), surf.height)
