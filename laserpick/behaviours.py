@@ -36,7 +36,7 @@ from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose
-from laserpick.pipeline.surface import SURFACE_BAND, place_target
+from laserpick.pipeline.surface import SURFACE_BAND, on_floor, place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
@@ -1167,7 +1167,7 @@ class Behaviours:
         #: things (a keep-out box, points of the cloud), and those points.
         crowded: set[str] = set()
         crowding = [np.zeros((0, 3))]
-        if spot[2] < SURFACE_BAND:
+        if on_floor(float(spot[2])):
             # On the floor, the floor is the support: held level from the side 8 cm above
             # it, a pill bottle would go down with the wrist's spheres 8 mm over the floor,
             # as over a table top, and was refused three times for the floor's 2 cm margin.
@@ -1213,7 +1213,7 @@ class Behaviours:
             # A place keeps the grasp's orientation: a jar held from a shelf's edge with the
             # hand tilted up would take the wrist into the floor, mark after mark, where
             # "too close to something" told the user nothing they could see.
-            floor = spot[2] < SURFACE_BAND or "surface" not in crowded
+            floor = on_floor(float(spot[2])) or "surface" not in crowded
             into_what = "the floor" if floor else "the surface"
             return Failure(
                 "ik_plan",

@@ -32,6 +32,12 @@ SEEN_POINTS = 10
 STRAY_POINTS = 3
 
 
+def on_floor(height: float) -> bool:
+    """Whether a surface top at `height` (m, `base`) is the floor (z = 0), within
+    SURFACE_BAND: nothing falls from it, and it is the support under what stands on it."""
+    return height < SURFACE_BAND
+
+
 def voi_mask(points: np.ndarray, center: np.ndarray, settings: PerceptionSettings) -> np.ndarray:
     """Boolean mask of the points inside the volume of interest around `center` (m, `base`)."""
     c = np.asarray(center, np.float32)
@@ -185,8 +191,8 @@ def place_target(
 
     The mark must be on a flat surface (`is_flat_surface`). If it lies less than
     `place_edge_margin` (10 cm) behind the surface's front edge, the edge nearest the robot,
-    it moves straight back (+x) until it is 10 cm behind that edge. Not on the floor (its
-    top within SURFACE_BAND of z = 0): nothing falls from it, and its nearest seen boundary
+    it moves straight back (+x) until it is 10 cm behind that edge. Not on the floor
+    (`on_floor`): nothing falls from it, and its nearest seen boundary
     is only where the cameras' view begins (a cereal box marked 5 cm past it was set down
     5 cm from its mark). Returns the (3,) point on the surface at height z_top, or a Failure.
     """
@@ -202,7 +208,7 @@ def place_target(
     region, origin, cell = found
     x, y = float(mark[0]), float(mark[1])
     edge = front_edge_x(region, origin, cell, y)
-    if edge is not None and z_top > SURFACE_BAND and x - edge < settings.place_edge_margin:
+    if edge is not None and not on_floor(z_top) and x - edge < settings.place_edge_margin:
         x = edge + settings.place_edge_margin
     return np.array([x, y, z_top], np.float32)
 
