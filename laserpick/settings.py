@@ -473,6 +473,14 @@ class GraspSettings(BaseModel):
         " (grasp_detect.closing_region), and be offered before those that do not"
         " (selection.group): a pad that meets it only at its edge lets it spin out. Ours.",
     )
+    gpd_recentre: float = Field(
+        0.022,
+        ge=0,
+        description="How far (m) past each side of the pads a hand that is not centred"
+        " (gpd_patch_offset) looks for where its pads would meet the object along their face;"
+        " it is tried again moved along its axis onto that patch"
+        " (grasp_detect.patch_shifts). 0 turns this off. Ours: one pad width.",
+    )
     gpd_collision_voxel: float = Field(
         0.0,
         ge=0,

@@ -40,7 +40,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -55,6 +56,8 @@ POINT_BLOCK = 1024  #: points per block of slab_pairs' coordinate matrix (cache-
 PAIR_BLOCK = 8192  #: (sample, point) pairs per block of (orientations, pairs) arrays
 ORIENTED_BLOCK = 32768  #: (pair, orientation) combinations per block of flat arrays
 COLLISION_VOXEL = 0.010  #: voxel edge (m) of pruned_tips' bounds: only speed depends on it
+MIN_SHIFT = 0.001  #: m; patch_moves shifts no hand by less: the pads would feel no change
+MIN_TURN = math.radians(1.0)  #: rad; nor turns one by less
 ROUNDING = 1e-6  #: m added to distance bounds, well above float32 rounding near the target
 
 
@@ -821,6 +824,86 @@ def closing_region(
     return width, ok, centred
 
 
+def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
+    """How to move each of `found`'s hands so that its pads meet the object along their
+    faces, about their middle (closing_region's tangent patches): a turn (rad) about the hand
+    axis, through the sample, that brings the closing axis onto the normals where the pads
+    touch, then a shift (m) along the hand axis that brings the patches' middle onto the
+    pads' middle. (G,) each; NaN where there is no such move: either pad has no patch within
+    gpd_recentre of its edges, or the move is below MIN_TURN and MIN_SHIFT.
+
+    The contacts are found as closing_region finds them, at the hand's depth and placement,
+    but over a slab gpd_recentre wider on each side of the pads, and against the extremes of
+    that slab: off its middle, a pad meets a can's side where it is narrower than at its
+    axis, and the can is widest where the pad is not. The turn is the median over each pad's
+    contacts of the angle from the closing axis to their normals (to minus theirs, for the
+    right pad), in the plane the hand turns in, averaged over the pads.
+
+    Ours, beyond GPD. Its eight orientations step 26 degrees about the curvature axis and do
+    not include the normal itself, so no hand comes straight down onto the top of a can: the
+    nearest lean 13 degrees and close across it at that slant. And 500 samples seldom put a
+    hand right over an upright mug's axis: a mug held 11 mm off it slid along the pads onto
+    its handle (pick-place seed 200, task 8), and one held at a 12 degree slant turned in
+    them (seed 402, task 11).
+    """
+    s = hands.s
+    turn, shift = np.full(len(found), np.nan), np.full(len(found), np.nan)
+    if s.gpd_recentre <= 0 or not len(found):
+        return turn, shift
+    i = found.sample
+    region = [(s.pad_width / 2 + s.gpd_recentre, math.hypot(s.width_max, s.finger_length), np.inf)]
+    f, _, h, u, v, nu, nv = slab_pairs(
+        hands.tgt, found.samples[i], found.normal[i], found.axis[i], region, hands.normals
+    )
+    band = s.gpd_contact_band
+    theta = found.angles[found.orientation]
+
+    def contacts(theta: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Per pad, the pairs at its extreme within the hand turned to `theta` (G,) rad,
+        and their normals' components along its closing axis and approach."""
+        ct, st = np.cos(theta).astype(np.float32).take(f), np.sin(theta).astype(np.float32).take(f)
+        a = ct * u + st * v
+        cc = st * u - ct * v - found.offset.take(f)
+        tip = found.tip.take(f)
+        inside = (a <= tip) & (a >= tip - s.pad_depth) & (np.abs(cc) < s.width_max / 2)
+        cmax = np.full(len(found), -np.inf, np.float32)
+        cmin = np.full(len(found), np.inf, np.float32)
+        np.maximum.at(cmax, f[inside], cc[inside])
+        np.minimum.at(cmin, f[inside], cc[inside])
+        left = inside & (cc >= cmax.take(f) - band)
+        right = inside & (cc <= cmin.take(f) + band)
+        return left, right, st * nu - ct * nv, ct * nu + st * nv
+
+    def per_frame(on: np.ndarray, x: np.ndarray, stat: Callable) -> np.ndarray:
+        out = np.full(len(found), np.nan)
+        fs = f[on]
+        order = np.argsort(fs, kind="stable")
+        fs, xs = fs[order], x[on][order]
+        starts = np.flatnonzero(np.r_[True, fs[1:] != fs[:-1]]) if len(fs) else fs
+        for k, lo in enumerate(starts):
+            hi = starts[k + 1] if k + 1 < len(starts) else len(fs)
+            out[fs[lo]] = stat(xs[lo:hi])
+        return out
+
+    left, right, n_c, n_a = contacts(theta)
+    turn = (
+        per_frame(left, np.arctan2(n_a, n_c), np.median)
+        + per_frame(right, np.arctan2(-n_a, -n_c), np.median)
+    ) / 2
+    turned = theta + np.nan_to_num(turn)
+    left, right, n_c, _ = contacts(turned)
+    cos_tangent = math.cos(math.radians(s.gpd_tangent_deg))
+    middles = [
+        per_frame(left & (n_c >= cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
+        per_frame(right & (n_c <= -cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
+    ]
+    shift = (middles[0] + middles[1]) / 2
+    still = ~(np.abs(turn) >= MIN_TURN) & ~(np.abs(shift) >= MIN_SHIFT)
+    none = np.isnan(shift) | still
+    turn[none], shift[none] = np.nan, np.nan
+    return np.nan_to_num(turn), shift
+
+
 def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
     """(n_frames,) bool: False where a pad's antipodal contacts are all guessed points and
     their depths along the approach do not overlap those of the other pad's seen contacts.
@@ -932,11 +1015,12 @@ def detect_grasps(
     unit normals, pointing outward (toward the sensors). scene: (N, 3) the full cloud in
     `base`, table included; the target's own points are added to it for collisions. rng seeds
     the sampling: the same seed gives the same grasps. Returns grasps with pose (TCP in
-    `base`; columns hand axis, closing axis, approach) and width (m), in sample order.
-    timings, if given, receives the seconds spent in each stage (bench/grasp_detect_speed.py).
-    tilts (rad): each sample's frame is tried turned about its closing axis by each of these
-    (`tilted_frames`); the default, no tilt, is GPD's. guessed: (M,) bool, the target points
-    that were guessed (`mirrored_back`) rather than seen; see `guesses_face_seen`.
+    `base`; columns hand axis, closing axis, approach) and width (m), in sample order, then
+    the re-centred ones (`patch_shifts`). timings, if given, receives the seconds spent in
+    each stage (bench/grasp_detect_speed.py). tilts (rad): each sample's frame is tried
+    turned about its closing axis by each of these (`tilted_frames`); the default, no tilt,
+    is GPD's. guessed: (M,) bool, the target points that were guessed (`mirrored_back`)
+    rather than seen; see `guesses_face_seen`.
     """
     t_start = time.perf_counter()
     clock = [t_start]
@@ -944,7 +1028,7 @@ def detect_grasps(
     def lap(stage: str) -> None:
         now = time.perf_counter()
         if timings is not None:
-            timings[stage] = now - clock[0]
+            timings[stage] = timings.get(stage, 0.0) + now - clock[0]
         clock[0] = now
 
     s = cleared_hand(settings or get_settings().grasp)
@@ -964,50 +1048,171 @@ def detect_grasps(
     if tilts != (0.0,):
         normal, axis = tilted_frames(normal, axis, np.asarray(tilts, np.float64))
         samples = np.tile(samples, (len(tilts), 1))
-    angles = orientation_angles(s.gpd_orientations)
-    grid = ClosingGrid(s)
     lap("frames")
+    hands = Hands(tgt, normals, scene, centre, tree, s, guessed, lap)
+    found = hands.grasps(samples, normal, axis)
 
-    # The pads' contents: target points where the pads could be. Most frames cannot pass the
-    # antipodal test whatever the hand's depth and offset: they need no collision test.
-    tsid, tpid, th, tu, tv, nu, nv = pad_pairs(tgt, normals, samples, normal, axis, s)
-    possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, s)
-    live = np.flatnonzero(possible.any(axis=1))
-    lap("pad_pairs")
-
-    # Collisions and depth, for those frames: scene points where the hand could be.
-    tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
-    if len(live):
-        regions = hand_regions(s)
-        cloud = collision_cloud(scene, centre, tgt, tree, regions, s)
-        lap("crop")
-        pairs = CoarsePairs(cloud, samples[live], normal[live], axis[live], regions)
-        lap("collision_pairs")
-        tips[live] = pruned_tips(
-            pairs, samples[live], normal[live], axis[live], angles, grid, s, regions, possible[live]
+    # Ours: each hand whose pads meet the object off their middle is tried again moved along
+    # its axis onto the patch where they would meet it along their face.
+    off = np.flatnonzero(~found.centred)
+    turn, shift = patch_moves(hands, found.subset(off))
+    moved = np.flatnonzero(np.isfinite(shift))
+    lap("recentre")
+    recentred = None
+    if len(moved):
+        i = found.sample[off[moved]]
+        normal_i, axis_i = found.normal[i], found.axis[i]
+        c, sn = np.cos(turn[moved])[:, None], np.sin(turn[moved])[:, None]
+        again = hands.grasps(
+            found.samples[i] + shift[moved, None] * axis_i,
+            c * normal_i + sn * np.cross(axis_i, normal_i),  # turns the approach by `turn`
+            axis_i,
+            only=found.orientation[off[moved]],
         )
-    tips = tips.reshape(len(samples) * len(angles), -1)
-    has, k = middle_placement(np.isfinite(tips))
-    offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
-    tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    lap("deepest_tips")
-
-    keep = np.flatnonzero(has.reshape(len(samples), len(angles)).any(axis=1).take(tsid))
-    th, tu, tv, nu, nv, tsid, tpid = (x.take(keep) for x in (th, tu, tv, nu, nv, tsid, tpid))
-    pair_guessed = None if guessed is None else np.asarray(guessed, bool).take(tpid)
-    width, ok, centred = closing_region(
-        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s, pair_guessed
-    )
-    lap("closing_region")
-    good = np.flatnonzero(ok & has)
-    poses = grasp_poses(samples, normal, axis, angles, good, offset[good], tip[good], s)
+        recentred = again.subset(np.flatnonzero(again.centred))
+    poses = np.vstack([found.poses] + ([recentred.poses] if recentred else []))
     poses[:, :3, 3] += centre
+    width = np.concatenate([found.width] + ([recentred.width] if recentred else []))
+    centred = np.concatenate([found.centred] + ([recentred.centred] if recentred else []))
     if timings is not None:
         timings["total"] = time.perf_counter() - t_start
     return [
         Grasp(pose=T, width=float(w), pads_centred=bool(c))
-        for T, w, c in zip(poses, width[good], centred[good], strict=True)
+        for T, w, c in zip(poses, width, centred, strict=True)
     ]
+
+
+@dataclass(frozen=True)
+class Found:
+    """The passing candidates of some frames: (G,) each, or (G, 4, 4) poses relative to the
+    target's centre. sample, orientation: the frame's indices into `samples` and `angles`;
+    offset, tip: its hand centre on the closing axis and fingertip depth (m), as
+    closing_region has them."""
+
+    samples: np.ndarray
+    normal: np.ndarray
+    axis: np.ndarray
+    angles: np.ndarray
+    sample: np.ndarray
+    orientation: np.ndarray
+    offset: np.ndarray
+    tip: np.ndarray
+    width: np.ndarray
+    centred: np.ndarray
+    poses: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.sample)
+
+    def subset(self, keep: np.ndarray) -> Found:
+        """The candidates `keep` (indices) of these."""
+        per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
+        return replace(self, **{k: getattr(self, k)[keep] for k in per})
+
+
+class Hands:
+    """The detector's passes over frames of one target: its points relative to their centre
+    (`tgt`, with their normals and KD-tree), the collision cloud around them (built once, when
+    a frame first needs it) and the cleared hand `s`."""
+
+    def __init__(
+        self,
+        tgt: np.ndarray,
+        normals: np.ndarray,
+        scene: np.ndarray,
+        centre: np.ndarray,
+        tree: cKDTree,
+        s: GraspSettings,
+        guessed: np.ndarray | None,
+        lap: Callable[[str], None],
+    ) -> None:
+        self.tgt, self.normals, self.scene, self.centre, self.tree = (
+            tgt,
+            normals,
+            scene,
+            centre,
+            tree,
+        )
+        self.s, self.guessed, self.lap = s, guessed, lap
+        self.angles = orientation_angles(s.gpd_orientations)
+        self.grid = ClosingGrid(s)
+        self.regions = hand_regions(s)
+        self._cloud: np.ndarray | None = None
+
+    def cloud(self) -> np.ndarray:
+        if self._cloud is None:
+            self._cloud = collision_cloud(
+                self.scene, self.centre, self.tgt, self.tree, self.regions, self.s
+            )
+            self.lap("crop")
+        return self._cloud
+
+    def grasps(
+        self,
+        samples: np.ndarray,
+        normal: np.ndarray,
+        axis: np.ndarray,
+        only: np.ndarray | None = None,
+    ) -> Found:
+        """The passing candidates of every orientation of the frames at `samples` ((S, 3),
+        relative to the target's centre) with those normals and curvature axes; with `only`
+        ((S,) orientation indices), of that one orientation of each."""
+        s, angles, grid, lap = self.s, self.angles, self.grid, self.lap
+        # The pads' contents: target points where the pads could be. Most frames cannot pass
+        # the antipodal test whatever the hand's depth and offset: they need no collision
+        # test.
+        tsid, tpid, th, tu, tv, nu, nv = pad_pairs(self.tgt, self.normals, samples, normal, axis, s)
+        possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, s)
+        if only is not None:
+            possible &= np.arange(len(angles)) == np.asarray(only)[:, None]
+        live = np.flatnonzero(possible.any(axis=1))
+        lap("pad_pairs")
+
+        # Collisions and depth, for those frames: scene points where the hand could be.
+        tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
+        if len(live):
+            pairs = CoarsePairs(self.cloud(), samples[live], normal[live], axis[live], self.regions)
+            lap("collision_pairs")
+            tips[live] = pruned_tips(
+                pairs,
+                samples[live],
+                normal[live],
+                axis[live],
+                angles,
+                grid,
+                s,
+                self.regions,
+                possible[live],
+            )
+        tips = tips.reshape(len(samples) * len(angles), -1)
+        has, k = middle_placement(np.isfinite(tips))
+        offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
+        tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
+        lap("deepest_tips")
+
+        keep = np.flatnonzero(has.reshape(len(samples), len(angles)).any(axis=1).take(tsid))
+        th, tu, tv, nu, nv, tsid, tpid = (x.take(keep) for x in (th, tu, tv, nu, nv, tsid, tpid))
+        pair_guessed = None if self.guessed is None else np.asarray(self.guessed, bool).take(tpid)
+        width, ok, centred = closing_region(
+            th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s, pair_guessed
+        )
+        lap("closing_region")
+        good = np.flatnonzero(ok & has)
+        sample, orientation = np.divmod(good, len(angles))
+        poses = grasp_poses(samples, normal, axis, angles, good, offset[good], tip[good], s)
+        return Found(
+            samples,
+            normal,
+            axis,
+            angles,
+            sample,
+            orientation,
+            offset[good],
+            tip[good],
+            width[good],
+            centred[good],
+            poses,
+        )
 
 
 def grasp_poses(
