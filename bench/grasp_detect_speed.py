@@ -33,6 +33,7 @@ STAGES = (
     "collision_pairs",
     "deepest_tips",
     "closing_region",
+    "recentre",
     "total",
 )
 TYPICAL = (1000, 3000)  #: target sizes (points) of a typical segmented household object

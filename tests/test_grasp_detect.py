@@ -79,10 +79,10 @@ def box(
     return np.vstack([f[0] for f in faces]), np.vstack([f[1] for f in faces])
 
 
-def detect(target, normals, others=(), seed=0) -> list[Grasp]:
+def detect(target, normals, others=(), seed=0, settings=S) -> list[Grasp]:
     scene = np.vstack([table(), target, *others]).astype(np.float32)
     return detect_grasps(
-        target.astype(np.float32), noisy(normals), scene, S, np.random.default_rng(seed)
+        target.astype(np.float32), noisy(normals), scene, settings, np.random.default_rng(seed)
     )
 
 
@@ -185,6 +185,58 @@ def test_a_can_from_above_is_centred_only_where_its_pads_meet_it_about_their_mid
     assert centred.sum() >= 20
     assert off[centred].max() <= S.gpd_patch_offset
     assert off[~centred].max() > 2 * S.gpd_patch_offset
+
+
+def can_axis_offset(g: Grasp, centre: tuple[float, float] = (0.0, 0.0)) -> float:
+    """How far (m) along the hand axis an upright can's axis at `centre` passes from the TCP."""
+    return float(np.array([centre[0] - g.position[0], centre[1] - g.position[1], 0.0]) @ g.axis)
+
+
+def test_off_centre_hands_are_turned_and_shifted_onto_their_patch():
+    """GPD's eight orientations do not include a sample's normal, so no hand comes straight
+    down onto a can's top: the nearest lean 13 degrees, and close across it at that slant,
+    where no pad meets it along its face. patch_moves turns each such hand about its axis
+    onto the normals its pads touch, and shifts it along its axis onto the patch where they
+    would meet the can along their face."""
+    pts, n = cylinder(r=0.033, height=0.122)
+    normals, scene = noisy(n), np.vstack([table(), pts]).astype(np.float32)
+    s = gd.cleared_hand(S)
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    tgt = pts - centre
+    tree = gd.cKDTree(tgt)
+    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(0))
+    normal, axis = gd.local_frames(tgt, normals, idx, s, tree)
+    hands = gd.Hands(tgt, normals, scene, centre, tree, s, None, lambda _: None)
+    found = hands.grasps(tgt[idx], normal, axis)
+    above = np.flatnonzero(~found.centred & (found.poses[:, 2, 2] < -0.9))
+    off = found.subset(above)
+    turn, shift = gd.patch_moves(hands, off)
+    moved = np.isfinite(shift)
+    assert moved.mean() > 0.8
+    # The turn levels the closing axis: it turns it by about as much as it leans.
+    lean = np.arcsin(off.poses[:, 2, 1])
+    assert np.abs(np.sin(turn - lean)[moved]).max() < math.sin(math.radians(S.gpd_tangent_deg))
+    # The shift brings the can's axis (through the target's centre) to the TCP, along the
+    # hand axis.
+    axis_at = -np.einsum("gi,gi->g", off.poses[:, :2, 0], off.poses[:, :2, 3])
+    assert np.median(np.abs(shift - axis_at)[moved]) < 0.002
+
+
+def test_recentring_adds_centred_hands_after_the_first():
+    pts, n = cylinder(r=0.033, height=0.122)
+    first = detect(pts, n, settings=S.model_copy(update={"gpd_recentre": 0.0}))
+    both = detect(pts, n)
+    assert len(both) > len(first)
+    for g, h in zip(first, both, strict=False):  # GPD's own candidates come first, unchanged
+        np.testing.assert_array_equal(g.pose, h.pose)
+    added = both[len(first) :]
+    assert all(g.pads_centred for g in added)
+    above = [g for g in both if g.approach[2] < -0.9]
+    level = math.sin(math.radians(S.gpd_tangent_deg))
+    assert all(abs(can_axis_offset(g)) <= S.gpd_patch_offset for g in above if g.pads_centred)
+    assert all(abs(g.closing[2]) <= level for g in added if g.approach[2] < -0.9)
+    n_first = sum(g.pads_centred and g.approach[2] < -0.9 for g in first)
+    assert sum(g.pads_centred for g in above) >= 2 * n_first
 
 
 def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():

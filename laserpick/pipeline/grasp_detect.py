@@ -824,86 +824,6 @@ def closing_region(
     return width, ok, centred
 
 
-def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
-    """How to move each of `found`'s hands so that its pads meet the object along their
-    faces, about their middle (closing_region's tangent patches): a turn (rad) about the hand
-    axis, through the sample, that brings the closing axis onto the normals where the pads
-    touch, then a shift (m) along the hand axis that brings the patches' middle onto the
-    pads' middle. (G,) each; NaN where there is no such move: either pad has no patch within
-    gpd_recentre of its edges, or the move is below MIN_TURN and MIN_SHIFT.
-
-    The contacts are found as closing_region finds them, at the hand's depth and placement,
-    but over a slab gpd_recentre wider on each side of the pads, and against the extremes of
-    that slab: off its middle, a pad meets a can's side where it is narrower than at its
-    axis, and the can is widest where the pad is not. The turn is the median over each pad's
-    contacts of the angle from the closing axis to their normals (to minus theirs, for the
-    right pad), in the plane the hand turns in, averaged over the pads.
-
-    Ours, beyond GPD. Its eight orientations step 26 degrees about the curvature axis and do
-    not include the normal itself, so no hand comes straight down onto the top of a can: the
-    nearest lean 13 degrees and close across it at that slant. And 500 samples seldom put a
-    hand right over an upright mug's axis: a mug held 11 mm off it slid along the pads onto
-    its handle (pick-place seed 200, task 8), and one held at a 12 degree slant turned in
-    them (seed 402, task 11).
-    """
-    s = hands.s
-    turn, shift = np.full(len(found), np.nan), np.full(len(found), np.nan)
-    if s.gpd_recentre <= 0 or not len(found):
-        return turn, shift
-    i = found.sample
-    region = [(s.pad_width / 2 + s.gpd_recentre, math.hypot(s.width_max, s.finger_length), np.inf)]
-    f, _, h, u, v, nu, nv = slab_pairs(
-        hands.tgt, found.samples[i], found.normal[i], found.axis[i], region, hands.normals
-    )
-    band = s.gpd_contact_band
-    theta = found.angles[found.orientation]
-
-    def contacts(theta: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Per pad, the pairs at its extreme within the hand turned to `theta` (G,) rad,
-        and their normals' components along its closing axis and approach."""
-        ct, st = np.cos(theta).astype(np.float32).take(f), np.sin(theta).astype(np.float32).take(f)
-        a = ct * u + st * v
-        cc = st * u - ct * v - found.offset.take(f)
-        tip = found.tip.take(f)
-        inside = (a <= tip) & (a >= tip - s.pad_depth) & (np.abs(cc) < s.width_max / 2)
-        cmax = np.full(len(found), -np.inf, np.float32)
-        cmin = np.full(len(found), np.inf, np.float32)
-        np.maximum.at(cmax, f[inside], cc[inside])
-        np.minimum.at(cmin, f[inside], cc[inside])
-        left = inside & (cc >= cmax.take(f) - band)
-        right = inside & (cc <= cmin.take(f) + band)
-        return left, right, st * nu - ct * nv, ct * nu + st * nv
-
-    def per_frame(on: np.ndarray, x: np.ndarray, stat: Callable) -> np.ndarray:
-        out = np.full(len(found), np.nan)
-        fs = f[on]
-        order = np.argsort(fs, kind="stable")
-        fs, xs = fs[order], x[on][order]
-        starts = np.flatnonzero(np.r_[True, fs[1:] != fs[:-1]]) if len(fs) else fs
-        for k, lo in enumerate(starts):
-            hi = starts[k + 1] if k + 1 < len(starts) else len(fs)
-            out[fs[lo]] = stat(xs[lo:hi])
-        return out
-
-    left, right, n_c, n_a = contacts(theta)
-    turn = (
-        per_frame(left, np.arctan2(n_a, n_c), np.median)
-        + per_frame(right, np.arctan2(-n_a, -n_c), np.median)
-    ) / 2
-    turned = theta + np.nan_to_num(turn)
-    left, right, n_c, _ = contacts(turned)
-    cos_tangent = math.cos(math.radians(s.gpd_tangent_deg))
-    middles = [
-        per_frame(left & (n_c >= cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
-        per_frame(right & (n_c <= -cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
-    ]
-    shift = (middles[0] + middles[1]) / 2
-    still = ~(np.abs(turn) >= MIN_TURN) & ~(np.abs(shift) >= MIN_SHIFT)
-    none = np.isnan(shift) | still
-    turn[none], shift[none] = np.nan, np.nan
-    return np.nan_to_num(turn), shift
-
-
 def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
     """(n_frames,) bool: False where a pad's antipodal contacts are all guessed points and
     their depths along the approach do not overlap those of the other pad's seen contacts.
@@ -1016,8 +936,9 @@ def detect_grasps(
     `base`, table included; the target's own points are added to it for collisions. rng seeds
     the sampling: the same seed gives the same grasps. Returns grasps with pose (TCP in
     `base`; columns hand axis, closing axis, approach) and width (m), in sample order, then
-    the re-centred ones (`patch_shifts`). timings, if given, receives the seconds spent in
-    each stage (bench/grasp_detect_speed.py). tilts (rad): each sample's frame is tried
+    the hands moved onto their patches (`Hands.recentred`). timings, if given, receives the
+    seconds spent in each stage (bench/grasp_detect_speed.py; the second pass adds to the
+    first's stages). tilts (rad): each sample's frame is tried
     turned about its closing axis by each of these (`tilted_frames`); the default, no tilt,
     is GPD's. guessed: (M,) bool, the target points that were guessed (`mirrored_back`)
     rather than seen; see `guesses_face_seen`.
@@ -1051,34 +972,19 @@ def detect_grasps(
     lap("frames")
     hands = Hands(tgt, normals, scene, centre, tree, s, guessed, lap)
     found = hands.grasps(samples, normal, axis)
-
-    # Ours: each hand whose pads meet the object off their middle is tried again moved along
-    # its axis onto the patch where they would meet it along their face.
-    off = np.flatnonzero(~found.centred)
-    turn, shift = patch_moves(hands, found.subset(off))
-    moved = np.flatnonzero(np.isfinite(shift))
-    lap("recentre")
-    recentred = None
-    if len(moved):
-        i = found.sample[off[moved]]
-        normal_i, axis_i = found.normal[i], found.axis[i]
-        c, sn = np.cos(turn[moved])[:, None], np.sin(turn[moved])[:, None]
-        again = hands.grasps(
-            found.samples[i] + shift[moved, None] * axis_i,
-            c * normal_i + sn * np.cross(axis_i, normal_i),  # turns the approach by `turn`
-            axis_i,
-            only=found.orientation[off[moved]],
-        )
-        recentred = again.subset(np.flatnonzero(again.centred))
-    poses = np.vstack([found.poses] + ([recentred.poses] if recentred else []))
+    passes = (found, hands.recentred(found))
+    poses = np.vstack([f.poses for f in passes])
     poses[:, :3, 3] += centre
-    width = np.concatenate([found.width] + ([recentred.width] if recentred else []))
-    centred = np.concatenate([found.centred] + ([recentred.centred] if recentred else []))
     if timings is not None:
         timings["total"] = time.perf_counter() - t_start
     return [
         Grasp(pose=T, width=float(w), pads_centred=bool(c))
-        for T, w, c in zip(poses, width, centred, strict=True)
+        for T, w, c in zip(
+            poses,
+            np.concatenate([f.width for f in passes]),
+            np.concatenate([f.centred for f in passes]),
+            strict=True,
+        )
     ]
 
 
@@ -1213,6 +1119,107 @@ class Hands:
             centred[good],
             poses,
         )
+
+    def recentred(self, found: Found) -> Found:
+        """The hands of `found` that are not centred, moved onto their patches
+        (`patch_moves`) and tested again from scratch: those that pass and are centred now.
+        Ours, beyond GPD (see patch_moves)."""
+        off = np.flatnonzero(~found.centred)
+        turn, shift = patch_moves(self, found.subset(off))
+        moved = np.flatnonzero(np.isfinite(shift))
+        self.lap("recentre")
+        if not len(moved):
+            return found.subset(moved)
+        i = found.sample[off[moved]]
+        normal, axis = found.normal[i], found.axis[i]
+        c, s = np.cos(turn[moved])[:, None], np.sin(turn[moved])[:, None]
+        again = self.grasps(
+            found.samples[i] + shift[moved, None] * axis,
+            c * normal + s * np.cross(axis, normal),  # turns the approach by `turn`
+            axis,
+            only=found.orientation[off[moved]],
+        )
+        return again.subset(np.flatnonzero(again.centred))
+
+
+def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
+    """How to move each of `found`'s hands so that its pads meet the object along their
+    faces, about their middle (closing_region's tangent patches): a turn (rad) about the hand
+    axis, through the sample, that brings the closing axis onto the normals where the pads
+    touch, then a shift (m) along the hand axis that brings the patches' middle onto the
+    pads' middle. (G,) each; NaN where there is no such move: either pad has no patch within
+    gpd_recentre of its edges, or the move is below MIN_TURN and MIN_SHIFT.
+
+    The contacts are found as closing_region finds them, at the hand's depth and placement,
+    but over a slab gpd_recentre wider on each side of the pads, and against the extremes of
+    that slab: off its middle, a pad meets a can's side where it is narrower than at its
+    axis, and the can is widest where the pad is not. The turn is the median over each pad's
+    contacts of the angle from the closing axis to their normals (to minus theirs, for the
+    right pad), in the plane the hand turns in, averaged over the pads.
+
+    Ours, beyond GPD. Its eight orientations step 26 degrees about the curvature axis and do
+    not include the normal itself, so no hand comes straight down onto the top of a can: the
+    nearest lean 13 degrees and close across it at that slant. And 500 samples seldom put a
+    hand right over an upright mug's axis: a mug held 11 mm off it slid along the pads onto
+    its handle (pick-place seed 200, task 8), and one held at a 12 degree slant turned in
+    them (seed 402, task 11).
+    """
+    s = hands.s
+    turn, shift = np.full(len(found), np.nan), np.full(len(found), np.nan)
+    if s.gpd_recentre <= 0 or not len(found):
+        return turn, shift
+    i = found.sample
+    region = [(s.pad_width / 2 + s.gpd_recentre, math.hypot(s.width_max, s.finger_length), np.inf)]
+    f, _, h, u, v, nu, nv = slab_pairs(
+        hands.tgt, found.samples[i], found.normal[i], found.axis[i], region, hands.normals
+    )
+    band = s.gpd_contact_band
+    theta = found.angles[found.orientation]
+
+    def contacts(theta: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Per pad, the pairs at its extreme within the hand turned to `theta` (G,) rad,
+        and their normals' components along its closing axis and approach."""
+        ct, st = np.cos(theta).astype(np.float32).take(f), np.sin(theta).astype(np.float32).take(f)
+        a = ct * u + st * v
+        cc = st * u - ct * v - found.offset.take(f)
+        tip = found.tip.take(f)
+        inside = (a <= tip) & (a >= tip - s.pad_depth) & (np.abs(cc) < s.width_max / 2)
+        cmax = np.full(len(found), -np.inf, np.float32)
+        cmin = np.full(len(found), np.inf, np.float32)
+        np.maximum.at(cmax, f[inside], cc[inside])
+        np.minimum.at(cmin, f[inside], cc[inside])
+        left = inside & (cc >= cmax.take(f) - band)
+        right = inside & (cc <= cmin.take(f) + band)
+        return left, right, st * nu - ct * nv, ct * nu + st * nv
+
+    def per_frame(on: np.ndarray, x: np.ndarray, stat: Callable) -> np.ndarray:
+        out = np.full(len(found), np.nan)
+        fs = f[on]
+        order = np.argsort(fs, kind="stable")
+        fs, xs = fs[order], x[on][order]
+        starts = np.flatnonzero(np.r_[True, fs[1:] != fs[:-1]]) if len(fs) else fs
+        for k, lo in enumerate(starts):
+            hi = starts[k + 1] if k + 1 < len(starts) else len(fs)
+            out[fs[lo]] = stat(xs[lo:hi])
+        return out
+
+    left, right, n_c, n_a = contacts(theta)
+    turn = (
+        per_frame(left, np.arctan2(n_a, n_c), np.median)
+        + per_frame(right, np.arctan2(-n_a, -n_c), np.median)
+    ) / 2
+    turned = theta + np.nan_to_num(turn)
+    left, right, n_c, _ = contacts(turned)
+    cos_tangent = math.cos(math.radians(s.gpd_tangent_deg))
+    middles = [
+        per_frame(left & (n_c >= cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
+        per_frame(right & (n_c <= -cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
+    ]
+    shift = (middles[0] + middles[1]) / 2
+    still = ~(np.abs(turn) >= MIN_TURN) & ~(np.abs(shift) >= MIN_SHIFT)
+    none = np.isnan(shift) | still
+    turn[none], shift[none] = np.nan, np.nan
+    return np.nan_to_num(turn), shift
 
 
 def grasp_poses(
