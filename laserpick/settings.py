@@ -478,8 +478,8 @@ class GraspSettings(BaseModel):
         ge=0,
         description="How far (m) past each side of the pads a hand that is not centred"
         " (gpd_patch_offset) looks for where its pads would meet the object along their face;"
-        " it is tried again moved along its axis onto that patch"
-        " (grasp_detect.patch_shifts). 0 turns this off. Ours: one pad width.",
+        " it is tried again turned about its axis and moved along it onto that patch"
+        " (grasp_detect.patch_moves). 0 turns this off. Ours: one pad width.",
     )
     gpd_collision_voxel: float = Field(
         0.0,

@@ -938,10 +938,10 @@ def detect_grasps(
     `base`; columns hand axis, closing axis, approach) and width (m), in sample order, then
     the hands moved onto their patches (`Hands.recentred`). timings, if given, receives the
     seconds spent in each stage (bench/grasp_detect_speed.py; the second pass adds to the
-    first's stages). tilts (rad): each sample's frame is tried
-    turned about its closing axis by each of these (`tilted_frames`); the default, no tilt,
-    is GPD's. guessed: (M,) bool, the target points that were guessed (`mirrored_back`)
-    rather than seen; see `guesses_face_seen`.
+    first's stages). tilts (rad): each sample's frame is tried turned about its closing axis
+    by each of these (`tilted_frames`); the default, no tilt, is GPD's. guessed: (M,) bool,
+    the target points that were guessed (`mirrored_back`) rather than seen; see
+    `guesses_face_seen`.
     """
     t_start = time.perf_counter()
     clock = [t_start]
@@ -1032,13 +1032,8 @@ class Hands:
         guessed: np.ndarray | None,
         lap: Callable[[str], None],
     ) -> None:
-        self.tgt, self.normals, self.scene, self.centre, self.tree = (
-            tgt,
-            normals,
-            scene,
-            centre,
-            tree,
-        )
+        self.tgt, self.normals, self.tree = tgt, normals, tree
+        self.scene, self.centre = scene, centre
         self.s, self.guessed, self.lap = s, guessed, lap
         self.angles = orientation_angles(s.gpd_orientations)
         self.grid = ClosingGrid(s)
@@ -1046,6 +1041,7 @@ class Hands:
         self._cloud: np.ndarray | None = None
 
     def cloud(self) -> np.ndarray:
+        """The collision cloud (`collision_cloud`), relative to the target's centre."""
         if self._cloud is None:
             self._cloud = collision_cloud(
                 self.scene, self.centre, self.tgt, self.tree, self.regions, self.s
@@ -1147,8 +1143,9 @@ def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
     faces, about their middle (closing_region's tangent patches): a turn (rad) about the hand
     axis, through the sample, that brings the closing axis onto the normals where the pads
     touch, then a shift (m) along the hand axis that brings the patches' middle onto the
-    pads' middle. (G,) each; NaN where there is no such move: either pad has no patch within
-    gpd_recentre of its edges, or the move is below MIN_TURN and MIN_SHIFT.
+    pads' middle. (G,) each. Where there is no such move, the shift is NaN (and the turn 0):
+    either pad has no patch within gpd_recentre of its edges, or the move is below MIN_TURN
+    and MIN_SHIFT.
 
     The contacts are found as closing_region finds them, at the hand's depth and placement,
     but over a slab gpd_recentre wider on each side of the pads, and against the extremes of
@@ -1156,6 +1153,9 @@ def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
     axis, and the can is widest where the pad is not. The turn is the median over each pad's
     contacts of the angle from the closing axis to their normals (to minus theirs, for the
     right pad), in the plane the hand turns in, averaged over the pads.
+
+    The turned hand keeps the placement and fingertip depth found for the first; the second
+    pass (`Hands.recentred`) finds its own.
 
     Ours, beyond GPD. Its eight orientations step 26 degrees about the curvature axis and do
     not include the normal itself, so no hand comes straight down onto the top of a can: the
@@ -1193,6 +1193,7 @@ def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
         return left, right, st * nu - ct * nv, ct * nu + st * nv
 
     def per_frame(on: np.ndarray, x: np.ndarray, stat: Callable) -> np.ndarray:
+        """(G,) `stat` of `x` over each frame's pairs `on`; NaN for a frame with none."""
         out = np.full(len(found), np.nan)
         fs = f[on]
         order = np.argsort(fs, kind="stable")
