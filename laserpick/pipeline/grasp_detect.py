@@ -1192,8 +1192,8 @@ def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
         right = inside & (cc <= cmin.take(f) + band)
         return left, right, st * nu - ct * nv, ct * nu + st * nv
 
-    def per_frame(on: np.ndarray, x: np.ndarray, stat: Callable) -> np.ndarray:
-        """(G,) `stat` of `x` over each frame's pairs `on`; NaN for a frame with none."""
+    def medians(on: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """(G,) the median of `x` over each frame's pairs `on`; NaN for a frame with none."""
         out = np.full(len(found), np.nan)
         fs = f[on]
         order = np.argsort(fs, kind="stable")
@@ -1201,21 +1201,23 @@ def patch_moves(hands: Hands, found: Found) -> tuple[np.ndarray, np.ndarray]:
         starts = np.flatnonzero(np.r_[True, fs[1:] != fs[:-1]]) if len(fs) else fs
         for k, lo in enumerate(starts):
             hi = starts[k + 1] if k + 1 < len(starts) else len(fs)
-            out[fs[lo]] = stat(xs[lo:hi])
+            out[fs[lo]] = np.median(xs[lo:hi])
         return out
 
     left, right, n_c, n_a = contacts(theta)
-    turn = (
-        per_frame(left, np.arctan2(n_a, n_c), np.median)
-        + per_frame(right, np.arctan2(-n_a, -n_c), np.median)
-    ) / 2
+    turn = (medians(left, np.arctan2(n_a, n_c)) + medians(right, np.arctan2(-n_a, -n_c))) / 2
     turned = theta + np.nan_to_num(turn)
     left, right, n_c, _ = contacts(turned)
     cos_tangent = math.cos(math.radians(s.gpd_tangent_deg))
-    middles = [
-        per_frame(left & (n_c >= cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
-        per_frame(right & (n_c <= -cos_tangent), h, lambda x: (x.min() + x.max()) / 2),
-    ]
+    middles = []
+    for on in (left & (n_c >= cos_tangent), right & (n_c <= -cos_tangent)):
+        # As closing_region's patch extents; inf - inf: NaN where the pad has no patch.
+        lo = np.full(len(found), np.inf, np.float32)
+        hi = np.full(len(found), -np.inf, np.float32)
+        np.minimum.at(lo, f[on], h[on])
+        np.maximum.at(hi, f[on], h[on])
+        with np.errstate(invalid="ignore"):
+            middles.append(((lo + hi) / 2).astype(np.float64))
     shift = (middles[0] + middles[1]) / 2
     still = ~(np.abs(turn) >= MIN_TURN) & ~(np.abs(shift) >= MIN_SHIFT)
     none = np.isnan(shift) | still
