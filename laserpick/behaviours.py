@@ -36,6 +36,7 @@ from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose
+from laserpick.pipeline.recall import moved
 from laserpick.pipeline.surface import SURFACE_BAND, on_floor, place_target
 from laserpick.pipeline.trajectory import Trajectory
 from laserpick.pipeline.types import Failure, FusedCloud, Grasp
@@ -139,6 +140,10 @@ START_STUCK = 0.05
 MOTION_SLACK = 3.0
 #: Spacing (rad, largest joint) of the waypoints kept on the way back from a protective stop.
 BACK_STEP = 0.1
+#: How far (m, rad) the scooter may have gone since a pick for the object still to be put
+#: back the way it came (`Behaviours.put_back`): parked, the odometry stays put.
+PUT_BACK_MOVED = 0.005
+PUT_BACK_TURNED = np.radians(0.5)
 
 
 def turned_hand_xy(spot_xy: np.ndarray, middle_xy: np.ndarray, dyaw: float) -> np.ndarray:
@@ -212,6 +217,24 @@ class Held:
         it taken for part of them, were no longer on their spots once the hand had gone; set
         down as seen, they stood."""
         return self.as_seen_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
+
+
+@dataclass(frozen=True)
+class WayIn:
+    """How the hand came to hold what it holds, for setting it back down (`put_back`): the
+    odometry's pose at the grasp (x, y, yaw; m, rad), the approach's joint path (N, 6, rad)
+    from the pre-grasp pose to the grasp, and the joint paths run to the end since the hand
+    closed there, in order."""
+
+    base: np.ndarray
+    approach: np.ndarray
+    driven: tuple[np.ndarray, ...] = ()
+
+    def way_back(self) -> np.ndarray:
+        """Every joint path driven since the grasp, backwards, as one (N, 6)."""
+        back = np.vstack([p[::-1] for p in reversed(self.driven)])
+        keep = np.r_[True, np.abs(np.diff(back, axis=0)).max(axis=1) > 1e-9]
+        return back[keep]
 
 
 def front_wall(points: np.ndarray, height: float) -> np.ndarray:
@@ -329,6 +352,7 @@ class Behaviours:
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.progress = progress or (lambda msg: log.info(msg))
         self.held: Held | None = None
+        self.way_in: WayIn | None = None
 
     # --- motion primitives -------------------------------------------------------------------
 
@@ -344,6 +368,7 @@ class Behaviours:
             waited += 0.05
         if np.max(np.abs(self._q() - traj.q[0])) > START_STUCK:
             self.robot.halt()
+            self.way_in = None
             return Failure(
                 "execute",
                 f"The arm stopped short of where {what} starts: it may be touching something.",
@@ -351,7 +376,10 @@ class Behaviours:
         handle = self.robot.execute(traj)
         status = self.robot.wait(handle, traj.duration + MOTION_SLACK)
         if status == "done":
+            if self.way_in is not None and self.held is not None:
+                self.way_in = replace(self.way_in, driven=(*self.way_in.driven, traj.q))
             return None
+        self.way_in = None  # stopped part way: the way back is no longer known
         if status == "running":
             self.robot.halt()  # not the latching e-stop: that one stays the user's
             return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
@@ -467,6 +495,7 @@ class Behaviours:
         if self.robot.gripper_state().holding:
             return Outcome(Failure("precondition", "The hand is already holding something."))
         order = list(order) if order is not None else grasps.ordered()
+        self.way_in = None
         t0 = time.perf_counter()
         plan, grasp, attempts = plan_first(grasps, self._q(), self.rng, order, s)
         timings = {"plan": time.perf_counter() - t0}
@@ -507,6 +536,7 @@ class Behaviours:
         middle = grasp.in_hand(grasps.middle[None])[0]
         seen_tcp = grasp.in_hand(grasps.carried_as_seen) if len(grasps.cut_off) else None
         self.held = Held(grasp, height, pts_tcp, middle, around, self.robot.base_pose(), seen_tcp)
+        self.way_in = WayIn(self.robot.base_pose(), plan.approach.q)
         # 002's re-grip: lift a little, so the object hangs in the hand, and squeeze again.
         failure = self._run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
         self.robot.gripper(True)
@@ -833,6 +863,60 @@ class Behaviours:
             if out.ok or out.failure is None or out.failure.kind != "ik_plan":
                 return out  # it went there, or a motion was stopped: no second one
         return self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
+
+    def put_back(self) -> Outcome:
+        """Set what the hand holds back down where it was picked up, and take the open hand
+        off it: for when no way out holding it is found. Left holding it, the arm stood in
+        a shelf's gap with a pill bottle in hand and the task ended there (2 of 195
+        pick-place tasks and 1 of 50 in-situ trials); set back down, it can be tried again.
+
+        Down the way it came up: every motion run since the hand closed (`WayIn`), backwards,
+        guarded as a place's descent is. Nothing else has moved since, so that way is clear.
+        An object that slid down in the pads meets its surface early: within `place_above`
+        of where it stood it is let go there, eased off it; met higher, it is something
+        else, and the hand keeps the object. The open hand then leaves it as it leaves a
+        placed object (`_leave_placed`), unchecked at worst along the way it came in.
+        Refused where that way back is not known: a motion was stopped since the grasp, or
+        the scooter has moved."""
+        s = self.settings.motion
+        held, way = self.held, self.way_in
+        if held is None or not self.robot.gripper_state().holding:
+            return Outcome(Failure("precondition", "The hand is not holding anything."))
+        if way is None or not way.driven:
+            msg = "I can't put the object back: the way the arm came with it is not known."
+            return Outcome(Failure("precondition", msg))
+        if moved(way.base, self.robot.base_pose(), PUT_BACK_MOVED, PUT_BACK_TURNED):
+            msg = "I can't put the object back: the scooter has moved since the pick."
+            return Outcome(Failure("precondition", msg))
+        self.progress("Putting the object back where it was.")
+        back = way.way_back()
+        T_grasp = tcp_pose(back[-1])
+        failure = self._descend(back, s.approach_speed, "putting the object back")
+        if failure is not None:
+            if "unexpected contact" not in failure.message:
+                return Outcome(failure, held.grasp)
+            early = float(tcp_pose(self._q())[2, 3] - T_grasp[2, 3])
+            if early > s.place_above:
+                msg = (
+                    f"Putting the object back, it met something {early * 100:.0f} cm above"
+                    " where it stood, so I kept it."
+                )
+                return Outcome(Failure("execute", msg), held.grasp)
+            eased = tcp_pose(self._q())
+            eased[2, 3] += s.place_ease
+            self._rise_straight(eased, "easing off the surface")
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        self.held = None
+        self.way_in = None
+        # Out along the approach, as far above the way in as the hand stands above the grasp.
+        T_out = tcp_pose(way.approach[0])
+        T_out[:3, 3] += tcp_pose(self._q())[:3, 3] - T_grasp[:3, 3]
+        failure = self._leave_placed(T_out, held.surroundings)
+        if failure is not None:
+            return Outcome(failure, held.grasp)
+        self.progress("Put back.")
+        return Outcome(None, held.grasp)
 
     @staticmethod
     def _holding_pose(q: np.ndarray, checker: CollisionChecker, payload: np.ndarray) -> np.ndarray:

@@ -487,6 +487,57 @@ def test_a_held_object_still_touching_its_surroundings_is_raised_before_the_tuck
     assert robot.gripper_state().holding
 
 
+def test_an_object_with_no_way_out_is_put_back_where_it_stood(robot):
+    """Where no way out holding the object is found (the tuck's searches or the carry's),
+    the hand sets it back down the way it came up, lets go, and draws back out along its
+    approach: the object stands where it stood, and the arm can go home. Nothing is put
+    back once the hand is empty."""
+    name = "mug_1"
+    referee = Referee(robot)
+    stood, axis = referee.world_position(name), matrix_from_quat(referee.world_quat(name))[:, 2]
+    b, _ = _pick(robot, name)
+    assert referee.world_position(name)[2] > stood[2] + 0.08, "lifted"
+    way = b.way_in
+    assert way is not None and len(way.driven) >= 2, "the re-grip's lift and the lift"
+    let_go_at: list[float] = []
+    gripper = robot.gripper
+
+    def recording_gripper(close: bool) -> None:
+        if not close:
+            let_go_at.append(float(referee.object_points(name, frame="world")[:, 2].min()))
+        gripper(close)
+
+    robot.gripper = recording_gripper  # type: ignore[method-assign]
+    out = b.put_back()
+    assert out.ok, out.failure
+    robot.sleep(1.0)
+    assert b.held is None and not robot.gripper_state().closed
+    assert len(let_go_at) == 1 and abs(let_go_at[0] - TABLE_TOP) < 0.004, "let go on the table"
+    now = referee.world_position(name)
+    assert np.linalg.norm(now[:2] - stood[:2]) < 0.01 and abs(now[2] - stood[2]) < 0.005
+    turned = matrix_from_quat(referee.world_quat(name))[:, 2]
+    assert math.degrees(math.acos(min(1.0, float(axis @ turned)))) < 3.0, "upright"
+    # Out along the approach, as it came in.
+    grasp, out_of_it = tcp_pose(way.driven[0][0]), tcp_pose(robot.joint_state().q)
+    drawn = out_of_it[:3, 3] - grasp[:3, 3]
+    assert float(drawn @ -grasp[:3, 2]) > 0.04
+    assert np.linalg.norm(np.cross(drawn, grasp[:3, 2])) < 0.01
+    assert b.stow().ok
+    again = b.put_back()
+    assert again.failure is not None and again.failure.kind == "precondition"
+
+
+def test_an_object_is_not_put_back_once_the_scooter_has_moved(robot):
+    """The way back down is the way up only from where the scooter stood at the pick."""
+    b, _ = _pick(robot, "mug_1")
+    robot.drive(-0.2, 0.0, 0.3)
+    robot.sleep(1.0)
+    out = b.put_back()
+    assert out.failure is not None and out.failure.kind == "precondition"
+    assert "scooter has moved" in out.failure.message
+    assert robot.gripper_state().holding and b.held is not None
+
+
 def test_a_rise_stops_before_the_arm_comes_near_anything(robot):
     """Rising clear of what the held object touches must not bring the arm itself near
     something else: a level hand raised swung its elbow back into the tiller and the sensor

@@ -3,17 +3,21 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import time
 
 import numpy as np
 from driving import drive_straight
 
-from laserpick.behaviours import PAST_THE_OPENING, Held, Outcome
+from laserpick.behaviours import HOLD_TURNS, PAST_THE_OPENING, Held, Outcome
 from laserpick.bench.operator import Referee
+from laserpick.description import dims
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.grasping import GraspSet
 from laserpick.pipeline.types import Failure
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.server.session import PLACED_NOT_STANDING, Actor, Session, TaskState
+from laserpick.server.session import PLACED_NOT_STANDING, PUT_BACK, Actor, Session, TaskState
 
 
 def test_a_click_confirmed_mark_is_perceived_in_the_cloud_it_was_aimed_in() -> None:
@@ -288,5 +292,51 @@ def test_a_drop_let_go_partly_past_the_basket_opening_asks_the_user_to_check() -
         assert session.state == TaskState.IDLE and session.failure is None, session.message
         assert session.message.startswith("Dropped in the basket.")
         assert PAST_THE_OPENING in session.message
+    finally:
+        session.close()
+
+
+def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() -> None:
+    """Picked in pick-and-place, the mug is to be tucked in. Here what the cameras saw is
+    told to fill every pose it could be held at, tucked in or raised in front, so no way
+    there is found: the hand sets the mug back down where it stood and the arm stows, the
+    user told why, free to mark it again."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        robot, actor, b = session.robot, Actor("bench"), session.behaviours
+        referee = Referee(robot)
+        robot.sim.settle(0.3)
+        stood = referee.world_position("mug_1")
+        pick = b.pick
+
+        def pick_with_nowhere_to_hold_it(grasps: GraspSet, order=None) -> Outcome:
+            out = pick(grasps, order)
+            held = b.held
+            assert held is not None, out.failure
+            held_at = []
+            for q, turn in itertools.product((dims.UR5_CARRY_Q, dims.UR5_HIGH_READY_Q), HOLD_TURNS):
+                turned = q.copy()
+                turned[5] += turn
+                held_at.append(held.at(tcp_pose(turned)))
+            filled = held.surroundings.with_points(np.vstack(held_at))
+            b.held = dataclasses.replace(held, surroundings=filled)
+            return out
+
+        b.pick = pick_with_nowhere_to_hold_it  # type: ignore[method-assign]
+        mug = referee.object_points("mug_1")
+        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
+        session.set_mode(actor, mode="pick_and_place")
+        session.aim_at(actor, centre, "base")
+        session.confirm(actor, point=centre)
+        _wait(lambda: not session.busy, 120.0)
+        session.execute(actor)
+        _wait(lambda: not session.busy, 240.0)
+        assert session.state == TaskState.IDLE, session.message
+        assert session.failure is not None and session.failure.kind == "ik_plan"
+        assert session.failure.message.endswith(PUT_BACK), session.failure.message
+        assert b.held is None and not robot.gripper_state().closed
+        now = referee.world_position("mug_1")
+        assert np.linalg.norm(now[:2] - stood[:2]) < 0.01 and abs(now[2] - stood[2]) < 0.005
+        assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05, "stowed"
     finally:
         session.close()

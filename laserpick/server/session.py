@@ -89,6 +89,8 @@ CAPTURE_MAX_AGE = 5.0
 #: (rad): the planner's clearance. What stood around the held object is then taken anew.
 HELD_MOVED = 0.01
 HELD_TURNED = math.radians(1.0)
+#: Said after a failure for which the arm found no way out holding the object.
+PUT_BACK = "I found no way out holding it, so I set it back down where it was."
 
 
 class TaskState(StrEnum):
@@ -909,7 +911,7 @@ class Session:
         tucked = self.behaviours.tuck()
         if not tucked.ok:
             assert tucked.failure is not None
-            self._end_badly(tucked.failure)
+            self._end_badly(tucked.failure, tucked=tucked)
             return
         with self._lock:
             self._set(TaskState.AWAITING_PLACE, "Mark where to put it, then confirm.")
@@ -1022,9 +1024,12 @@ class Session:
         points = points[self_filter(points, self.robot.joint_state().q)]
         return still_standing(points, placed.standing, float(placed.spot[2])) is False
 
-    def _end_badly(self, failure: Failure) -> None:
+    def _end_badly(self, failure: Failure, tucked: Outcome | None = None) -> None:
         """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
-        hand is kept (never dropped from height): the arm raises it and the session holds."""
+        hand is kept (never dropped from height): the arm tucks it in and the session holds;
+        where no way to tuck it in is found, it is put back where it was picked up, if the
+        arm can go back down the way it came (`Behaviours.put_back`), and the arm stows.
+        tucked: how the tuck that failed just now went (not tried again)."""
         cancelled = self._cancel.is_set()
         if self.estopped or (cancelled and self._cancel_reason == ESTOP_REASON):
             failure = Failure("execute", ESTOP_REASON)
@@ -1036,10 +1041,15 @@ class Session:
         self._cancel.clear()  # the retreat itself must be allowed to move
         b = self.behaviours
         if b.held is not None and self.robot.gripper_state().holding:
-            self._progress("Tucking in what the hand holds.")
-            self._held_here()
-            b.tuck()
-        else:
+            if tucked is None:
+                self._progress("Tucking in what the hand holds.")
+                self._held_here()
+                tucked = b.tuck()
+            if tucked.failure is not None and tucked.failure.kind == "ik_plan":
+                put = b.put_back()
+                if put.ok:
+                    failure = Failure(failure.kind, f"{failure.message} {PUT_BACK}")
+        if b.held is None or not self.robot.gripper_state().holding:
             if self.robot.gripper_state().closed:
                 self.robot.gripper(False)
                 self.robot.sleep(GRIPPER_TIME)
