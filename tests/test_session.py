@@ -340,3 +340,43 @@ def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() 
         assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05, "stowed"
     finally:
         session.close()
+
+
+def test_an_object_with_no_way_to_the_basket_from_where_it_was_lifted_is_tucked_in_first() -> None:
+    """Where the drop finds no way to the basket from where the lift left the object (a pill
+    bottle lifted in the bookshelf's gap, in-situ), the object is tucked in and carried to
+    the basket from there. The planner's "no way" for the first drop is stood in for here:
+    the isolation scene's mug has a clear one."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        robot, actor, b = session.robot, Actor("bench"), session.behaviours
+        referee = Referee(robot)
+        robot.sim.settle(0.3)
+        calls: list[str] = []
+        drop, tuck = b.drop_in_basket, b.tuck
+
+        def drop_found_no_way_at_first() -> Outcome:
+            calls.append("drop")
+            if calls.count("drop") == 1:
+                return Outcome(Failure("ik_plan", "No collision-free path was found."))
+            return drop()
+
+        def recording_tuck() -> Outcome:
+            calls.append("tuck")
+            return tuck()
+
+        b.drop_in_basket = drop_found_no_way_at_first  # type: ignore[method-assign]
+        b.tuck = recording_tuck  # type: ignore[method-assign]
+        mug = referee.object_points("mug_1")
+        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
+        session.set_mode(actor, mode="pick_and_drop")
+        session.aim_at(actor, centre, "base")
+        session.confirm(actor, point=centre)
+        _wait(lambda: not session.busy, 120.0)
+        session.execute(actor)
+        _wait(lambda: not session.busy, 240.0)
+        assert calls == ["drop", "tuck", "drop"]
+        assert session.state == TaskState.IDLE and session.failure is None, session.message
+        assert referee.in_basket("mug_1")
+    finally:
+        session.close()

@@ -918,7 +918,18 @@ class Session:
 
     def _drop_job(self) -> None:
         self._held_here()
-        out = self.behaviours.drop_in_basket()
+        b = self.behaviours
+        out = b.drop_in_basket()
+        if out.failure is not None and out.failure.kind == "ik_plan" and b.held is not None:
+            # No way to the basket from where the lift left the object, it is tucked in and
+            # carried from there: a pill bottle lifted in the bookshelf's gap found none,
+            # and was then tucked in and kept (in-situ).
+            self._progress("Tucking the object in on the way to the basket.")
+            tucked = b.tuck()
+            if not tucked.ok:
+                self._end_badly(out.failure, tucked=tucked)
+                return
+            out = b.drop_in_basket()
         if not out.ok:
             assert out.failure is not None
             self._end_badly(out.failure)
