@@ -867,8 +867,8 @@ class Behaviours:
     def put_back(self) -> Outcome:
         """Set what the hand holds back down where it was picked up, and take the open hand
         off it: for when no way out holding it is found. Left holding it, the arm stood in
-        a shelf's gap with a pill bottle in hand and the task ended there (2 of 195
-        pick-place tasks and 1 of 50 in-situ trials); set back down, it can be tried again.
+        the bookshelf's gap with a pill bottle in hand, and the task ended there (pick-place,
+        trial seed 102); set back down, it can be tried again.
 
         Down the way it came up: every motion run since the hand closed (`WayIn`), backwards,
         guarded as a place's descent is. Nothing else has moved since, so that way is clear.
