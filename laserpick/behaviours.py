@@ -548,9 +548,7 @@ class Behaviours:
             failure = Failure("execute", "The object slipped out of the hand while lifting.")
         if failure:
             if not self.should_stop():  # a cancel or an e-stop keeps what the hand holds
-                self.robot.gripper(False)
-                self.robot.sleep(GRIPPER_TIME)
-                self.held = None
+                self._let_go()
             return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         failure = self._withdraw(grasp.approach, around, pts_tcp)
         if failure:  # the hand keeps what it holds: the session tucks it in
@@ -669,6 +667,21 @@ class Behaviours:
     def _gripping(self) -> bool:
         state = self.robot.gripper_state()
         return state.closed and state.width > dims.GRIPPER_EMPTY_GAP
+
+    def _let_go(self) -> None:
+        """Open the hand and give it the time to open: it holds nothing from here."""
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        self.held = None
+        self.way_in = None
+
+    def _ease_off_surface(self) -> None:
+        """Rise `place_ease` straight up from where a guarded descent felt the surface under
+        what the hand holds: let go there, with no drop to roll from, but not pressed into
+        the surface (`MotionSettings.place_ease`)."""
+        eased = tcp_pose(self._q())
+        eased[2, 3] += self.settings.motion.place_ease
+        self._rise_straight(eased, "easing off the surface")
 
     def _back_off(self) -> None:
         """After a stopped approach: straight back along the approach axis."""
@@ -902,13 +915,8 @@ class Behaviours:
                     " where it stood, so I kept it."
                 )
                 return Outcome(Failure("execute", msg), held.grasp)
-            eased = tcp_pose(self._q())
-            eased[2, 3] += s.place_ease
-            self._rise_straight(eased, "easing off the surface")
-        self.robot.gripper(False)
-        self.robot.sleep(GRIPPER_TIME)
-        self.held = None
-        self.way_in = None
+            self._ease_off_surface()
+        self._let_go()
         # Out along the approach, as far above the way in as the hand stands above the grasp.
         T_out = tcp_pose(way.approach[0])
         T_out[:3, 3] += tcp_pose(self._q())[:3, 3] - T_grasp[:3, 3]
@@ -964,9 +972,7 @@ class Behaviours:
         lost = self._lost_on_the_way("the basket")
         if lost is not None:
             return lost
-        self.robot.gripper(False)
-        self.robot.sleep(GRIPPER_TIME)
-        self.held = None
+        self._let_go()
         self.progress("Released into the basket.")
         # The open hand rises off the object before it turns away: a tall bottle stands up
         # out of the basket, and a straight way to ready swept the fingers through it (152 N,
@@ -1060,14 +1066,9 @@ class Behaviours:
                     " so I kept it. Mark another spot.",
                 )
             )
-        # The guard stop is the surface met: let go there, with no drop to roll from, but
-        # eased off it first (`place_ease`), not pressing the object into it.
-        eased = tcp_pose(self._q())
-        eased[2, 3] += s.place_ease
-        self._rise_straight(eased, "easing off the surface")
-        self.robot.gripper(False)
-        self.robot.sleep(GRIPPER_TIME)
-        self.held = None
+        # The guard stop is the surface met: let go there, eased off it.
+        self._ease_off_surface()
+        self._let_go()
         T_release = tcp_pose(self._q())
         failure = self._leave_placed(T_above, checker)
         if failure is not None:

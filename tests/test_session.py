@@ -17,7 +17,14 @@ from laserpick.pipeline.grasping import GraspSet
 from laserpick.pipeline.types import Failure
 from laserpick.robot.scenes import load_scene
 from laserpick.robot.sim_robot import SimRobot
-from laserpick.server.session import PLACED_NOT_STANDING, PUT_BACK, Actor, Session, TaskState
+from laserpick.server.session import (
+    PLACED_NOT_STANDING,
+    PUT_BACK,
+    Actor,
+    Mode,
+    Session,
+    TaskState,
+)
 
 
 def test_a_click_confirmed_mark_is_perceived_in_the_cloud_it_was_aimed_in() -> None:
@@ -216,18 +223,24 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         session.close()
 
 
-def _mug_kept(session: Session, actor: Actor) -> Held:
-    """Pick the isolation scene's mug in pick-and-place and cancel its place, so that the
-    session holds it; what the hand holds."""
-    session.robot.sim.settle(0.3)
+def _fetch_mug(session: Session, actor: Actor, mode: Mode) -> None:
+    """Mark the isolation scene's mug, confirm, and execute in `mode`, as a user does; wait
+    for each job to end."""
     mug = Referee(session.robot).object_points("mug_1")
     centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
-    session.set_mode(actor, mode="pick_and_place")
+    session.set_mode(actor, mode=mode)
     session.aim_at(actor, centre, "base")
     session.confirm(actor, point=centre)
     _wait(lambda: not session.busy, 120.0)
     session.execute(actor)
-    _wait(lambda: not session.busy, 120.0)
+    _wait(lambda: not session.busy, 240.0)
+
+
+def _mug_kept(session: Session, actor: Actor) -> Held:
+    """Pick the isolation scene's mug in pick-and-place and cancel its place, so that the
+    session holds it; what the hand holds."""
+    session.robot.sim.settle(0.3)
+    _fetch_mug(session, actor, "pick_and_place")
     assert session.state == TaskState.AWAITING_PLACE, session.message
     session.cancel(actor)
     assert session.state == TaskState.HOLDING
@@ -323,14 +336,7 @@ def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() 
             return out
 
         b.pick = pick_with_nowhere_to_hold_it  # type: ignore[method-assign]
-        mug = referee.object_points("mug_1")
-        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
-        session.set_mode(actor, mode="pick_and_place")
-        session.aim_at(actor, centre, "base")
-        session.confirm(actor, point=centre)
-        _wait(lambda: not session.busy, 120.0)
-        session.execute(actor)
-        _wait(lambda: not session.busy, 240.0)
+        _fetch_mug(session, actor, "pick_and_place")
         assert session.state == TaskState.IDLE, session.message
         assert session.failure is not None and session.failure.kind == "ik_plan"
         assert session.failure.message.endswith(PUT_BACK), session.failure.message
@@ -367,14 +373,7 @@ def test_an_object_with_no_way_to_the_basket_from_where_it_was_lifted_is_tucked_
 
         b.drop_in_basket = drop_found_no_way_at_first  # type: ignore[method-assign]
         b.tuck = recording_tuck  # type: ignore[method-assign]
-        mug = referee.object_points("mug_1")
-        centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
-        session.set_mode(actor, mode="pick_and_drop")
-        session.aim_at(actor, centre, "base")
-        session.confirm(actor, point=centre)
-        _wait(lambda: not session.busy, 120.0)
-        session.execute(actor)
-        _wait(lambda: not session.busy, 240.0)
+        _fetch_mug(session, actor, "pick_and_drop")
         assert calls == ["drop", "tuck", "drop"]
         assert session.state == TaskState.IDLE and session.failure is None, session.message
         assert referee.in_basket("mug_1")
