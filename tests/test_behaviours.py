@@ -488,8 +488,8 @@ def test_a_held_object_still_touching_its_surroundings_is_raised_before_the_tuck
 
 
 def test_an_object_with_no_way_out_is_put_back_where_it_stood(robot):
-    """Where no way out holding the object is found (the tuck's searches or the carry's),
-    the hand sets it back down the way it came up, lets go, and draws back out along its
+    """Where no way out holding the object is found (the tuck's searches find none), the
+    hand sets it back down the way it came up, lets go, and draws back out along its
     approach: the object stands where it stood, and the arm can go home. Nothing is put
     back once the hand is empty."""
     name = "mug_1"
