@@ -527,6 +527,25 @@ def test_an_object_with_no_way_out_is_put_back_where_it_stood(robot):
     assert again.failure is not None and again.failure.kind == "precondition"
 
 
+def test_an_object_put_back_onto_something_else_is_kept(robot):
+    """Something set down since the pick where the object stood (the ball, here) is met on
+    the way back down well above the table: the hand keeps the object and says so, rather
+    than let it go onto what it met. (`place_above` is lowered to 3 cm here: the 6.8 cm
+    ball stops the mug about 6 cm up, too near the 6 cm default to test by.)"""
+    b, referee = _pick(robot, "mug_1")
+    stood = TABLE_TOP
+    ball = referee.free_joint("ball_1")
+    ball[:2] = referee.world_position("mug_1")[:2]
+    referee.put_back("ball_1", ball)
+    s = b.settings
+    b.settings = s.model_copy(update={"motion": s.motion.model_copy(update={"place_above": 0.03})})
+    out = b.put_back()
+    assert out.failure is not None and out.failure.kind == "execute", out.failure
+    assert "met something" in out.failure.message and "kept it" in out.failure.message
+    assert robot.gripper_state().holding and b.held is not None
+    assert referee.world_position("mug_1")[2] > stood + 0.04, "held above the ball"
+
+
 def test_an_object_is_not_put_back_once_the_scooter_has_moved(robot):
     """The way back down is the way up only from where the scooter stood at the pick."""
     b, _ = _pick(robot, "mug_1")

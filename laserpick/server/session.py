@@ -1060,6 +1060,9 @@ class Session:
                 put = b.put_back()
                 if put.ok:
                     failure = Failure(failure.kind, f"{failure.message} {PUT_BACK}")
+                elif put.failure is not None and put.failure.kind != "precondition":
+                    # Tried and stopped on the way down: the user hears why it is still held.
+                    failure = Failure(failure.kind, f"{failure.message} {put.failure.message}")
         if b.held is None or not self.robot.gripper_state().holding:
             if self.robot.gripper_state().closed:
                 self.robot.gripper(False)
