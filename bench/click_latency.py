@@ -206,8 +206,8 @@ def server_only(rounds: int) -> int:
 
     from laserpick.bench.operator import Referee
     from laserpick.console.operator_console import OperatorConsole
-    from laserpick.robot.scenes import load_scene
-    from laserpick.robot.sim_robot import SimRobot
+    from laserpick.robot.sim.robot import SimRobot
+    from laserpick.robot.sim.scenes import load_scene
     from laserpick.server.session import Actor, Session
 
     session = Session(SimRobot(load_scene("isolation"), realtime=True))

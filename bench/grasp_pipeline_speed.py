@@ -21,7 +21,7 @@ from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import GraspSet, find_grasps, plan_first
 from laserpick.pipeline.perceive import perceive
-from laserpick.pipeline.types import Failure
+from laserpick.types import Failure
 
 STAGES = ("detect", "filter", "select", "plan")
 

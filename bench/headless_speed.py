@@ -8,8 +8,8 @@ from __future__ import annotations
 import argparse
 import time
 
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim import Simulation
+from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.scenes import load_scene
 
 
 def main() -> None:

@@ -16,7 +16,7 @@ import numpy as np
 from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark
-from laserpick.pipeline.types import Failure
+from laserpick.types import Failure
 
 
 def main() -> None:

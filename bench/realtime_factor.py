@@ -38,9 +38,9 @@ import viser
 
 from laserpick.console import headless_chromium
 from laserpick.console.viewer import SceneViewer
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sensors import DepthCameras
-from laserpick.robot.sim import Simulation
+from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.scenes import load_scene
+from laserpick.robot.sim.sensors import DepthCameras
 from laserpick.settings import get_settings
 
 

@@ -15,8 +15,8 @@ import numpy as np
 from laserpick.bench.truth import capture, iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.segment import segment_target
-from laserpick.pipeline.types import Failure
 from laserpick.settings import get_settings
+from laserpick.types import Failure
 
 
 def main() -> None:

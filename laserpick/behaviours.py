@@ -38,11 +38,10 @@ from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.recall import moved
 from laserpick.pipeline.surface import SURFACE_BAND, on_floor, place_target
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import Failure, FusedCloud, Grasp
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.transforms import invert, planar_pose, roty, rotz
+from laserpick.types import Failure, FusedCloud, Grasp, Trajectory
 
 log = logging.getLogger(__name__)
 

@@ -233,7 +233,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from laserpick.bench.protocols import PROTOCOLS, Options
     from laserpick.bench.report import markdown, write_reports
     from laserpick.bench.runner import progress_bar, run
-    from laserpick.robot.scenes import SceneError, load_scene
+    from laserpick.robot.sim.scenes import SceneError, load_scene
 
     spec = PROTOCOLS[args.protocol]
     for name, value in (("--trials", args.trials), ("--workers", args.workers)):
@@ -303,7 +303,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
             return EXIT_USAGE
 
     # Heavy imports only once the arguments are sane: `laserpick --help` stays fast.
-    from laserpick.robot.scenes import load_scene
+    from laserpick.robot.sim.scenes import load_scene
 
     try:
         scene = load_scene(args.scene)
@@ -324,7 +324,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from laserpick.console.operator_console import OperatorConsole
     from laserpick.console.viewer import SceneViewer
-    from laserpick.robot.sim_robot import SimRobot
+    from laserpick.robot.sim.robot import SimRobot
     from laserpick.server.app import create_app
     from laserpick.server.session import Session
 

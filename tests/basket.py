@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from laserpick.robot.scenes import load_scene
+from laserpick.robot.sim.scenes import load_scene
 
 #: How the session says the object fell from the hand on the way to the basket.
 LOST_IN_CARRY = "fell from the hand while it was carried"

@@ -42,7 +42,7 @@ from schemathesis.checks import load_all_checks
 from serve_process import ServeProcess
 
 from laserpick.client import Client
-from laserpick.robot.scenes import builtin_scene_names
+from laserpick.robot.sim.scenes import builtin_scene_names
 from laserpick.settings import get_settings
 
 REPO = Path(__file__).resolve().parents[1]

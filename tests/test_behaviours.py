@@ -52,12 +52,11 @@ from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
 from laserpick.pipeline.selection import group, score
 from laserpick.pipeline.surface import still_standing
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import Failure, Grasp
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim import DRIVE_STOP
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.loop import DRIVE_STOP
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import matrix_from_quat
+from laserpick.types import Failure, Grasp, Trajectory
 
 TABLE_TOP = 0.46  # the isolation scene's table (m)
 TABLE_FRONT = 1.30  # its front edge's x (m, `world`)

@@ -74,9 +74,8 @@ from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import UNSEEN_WAYS
-from laserpick.pipeline.types import Failure
-from laserpick.robot.objects import LIBRARY
-from laserpick.robot.scenes import load_scene, scene_config
+from laserpick.robot.sim.objects import LIBRARY
+from laserpick.robot.sim.scenes import load_scene, scene_config
 from laserpick.transforms import (
     invert,
     matrix_from_quat,
@@ -85,6 +84,7 @@ from laserpick.transforms import (
     rotx,
     rotz,
 )
+from laserpick.types import Failure
 
 DATA = Path(__file__).parent / "data"
 

@@ -120,8 +120,8 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
 def test_viewer_nodes_follow_the_sim() -> None:
     viser = pytest.importorskip("viser")
     from laserpick.console.viewer import SceneViewer
-    from laserpick.robot.scenes import load_scene
-    from laserpick.robot.sim import Simulation
+    from laserpick.robot.sim.loop import Simulation
+    from laserpick.robot.sim.scenes import load_scene
 
     sim = Simulation(load_scene("isolation"), realtime=False)
     server = viser.ViserServer(host="127.0.0.1", port=_free_port(), verbose=False)
@@ -220,7 +220,8 @@ def test_lit_points_are_looked_up_by_their_projector_pixel() -> None:
     lights: a point on the axis of a lit pixel is lit, one beside it, one behind the lens or
     one outside the image is not."""
     from laserpick.console.operator_console import lit_by, projector_pixels
-    from laserpick.pipeline.projector import Projector, projector_intrinsics
+    from laserpick.pipeline.projector import projector_intrinsics
+    from laserpick.types import Projector
 
     w, h = 64, 48
     K = projector_intrinsics(w, h, 0.64, 0.48, 0.32, 0.24, 1.0)  # 100 px per metre at 1 m

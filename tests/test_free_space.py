@@ -18,7 +18,8 @@ from laserpick.pipeline.free_space import (
 )
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.types import (
+from laserpick.settings import GraspSettings
+from laserpick.types import (
     DepthFrame,
     FusedCloud,
     Grasp,
@@ -26,7 +27,6 @@ from laserpick.pipeline.types import (
     Segmentation,
     SupportSurface,
 )
-from laserpick.settings import GraspSettings
 
 TABLE = 0.46
 BOX_CENTRE = np.array([1.5, 0.0, TABLE + 0.10])

@@ -8,8 +8,8 @@ import pytest
 
 from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse, voxel_downsample
-from laserpick.pipeline.types import FusedCloud
 from laserpick.settings import PerceptionSettings
+from laserpick.types import FusedCloud
 
 TABLE_TOP = 0.46  #: m, isolation scene (scene_files/isolation.yaml)
 #: The table's top (x 1.3..1.9, y -0.65..0.35 in the scene file), inset 5 cm.

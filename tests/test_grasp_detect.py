@@ -13,8 +13,8 @@ import pytest
 
 from laserpick.pipeline import grasp_detect as gd
 from laserpick.pipeline.grasp_detect import detect_grasps
-from laserpick.pipeline.types import Grasp
 from laserpick.settings import GraspSettings
+from laserpick.types import Grasp
 
 S = GraspSettings()
 SPACING = 0.003  #: m between object points

@@ -15,11 +15,11 @@ import pytest
 from laserpick.description import dims
 from laserpick.description import kinematics as K
 from laserpick.pipeline.timing import time_parametrize
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.robot.objects import LIBRARY, min_width, support
-from laserpick.robot.scenes import parse_scene
-from laserpick.robot.sim import Simulation
+from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.objects import LIBRARY, min_width, support
+from laserpick.robot.sim.scenes import parse_scene
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
+from laserpick.types import Trajectory
 
 TABLE_HEIGHT = 0.46
 OBJECT_XY = (1.50, -0.25)

@@ -11,8 +11,8 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasp_detect import detect_grasps
 from laserpick.pipeline.grasping import GraspSet, find_grasps, vertical_grasp
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
 from laserpick.settings import get_settings
+from laserpick.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
 
 TABLE = 0.46
 SPACING = 0.003

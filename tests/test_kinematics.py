@@ -12,7 +12,7 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.description import kinematics as K
-from laserpick.robot.model import TCP_SITE, build_arm_model, build_arm_spec
+from laserpick.robot.sim.model import TCP_SITE, build_arm_model, build_arm_spec
 from laserpick.transforms import rotation_angle
 
 

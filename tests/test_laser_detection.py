@@ -10,8 +10,8 @@ import pytest
 from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark, direct_mark, find_spots, pair_spots
-from laserpick.pipeline.types import Failure, LaserMark
 from laserpick.settings import get_settings
+from laserpick.types import Failure, LaserMark
 
 
 @pytest.fixture(scope="module")

@@ -10,8 +10,8 @@ import pytest
 
 from laserpick.pipeline.approach import bearing_gain, centroid_approach
 from laserpick.pipeline.overhead import overhead_grasp
-from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import ApproachSettings
+from laserpick.types import Failure, Grasp
 
 TABLE = 0.46
 ARM_XY = np.array([1.14, -0.30])
@@ -115,7 +115,7 @@ def test_the_overhead_grasp_of_a_pill_beside_a_phone_closes_on_the_pill(tmp_path
     user parks."""
     from laserpick.bench.picking import BENCH
     from laserpick.bench.protocols import Options, _operated
-    from laserpick.robot.scenes import load_scene
+    from laserpick.robot.sim.scenes import load_scene
     from laserpick.server.session import TaskState
 
     scene = tmp_path / "pill.yaml"

@@ -9,7 +9,7 @@ import pytest
 from laserpick.bench.truth import capture, iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.perceive import perceive
-from laserpick.robot.scenes import parse_scene
+from laserpick.robot.sim.scenes import parse_scene
 
 
 @pytest.fixture(scope="module")

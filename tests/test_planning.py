@@ -35,9 +35,9 @@ from laserpick.pipeline.plan import (
     straight_lift,
 )
 from laserpick.pipeline.reach import reachable
-from laserpick.pipeline.types import Failure, Grasp
-from laserpick.robot.model import ModelInfo, build_sim_model
+from laserpick.robot.sim.model import ModelInfo, build_sim_model
 from laserpick.settings import MotionSettings, get_settings
+from laserpick.types import Failure, Grasp
 
 EMPTY = np.zeros((0, 3))
 

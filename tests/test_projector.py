@@ -12,15 +12,11 @@ import pytest
 from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.projector import (
-    Projector,
-    highlight_disc,
-    highlight_points,
-    projector_intrinsics,
-)
-from laserpick.robot.model import PROJECTOR_CAMERA
-from laserpick.robot.sensors import CAM_TO_OPTICAL
+from laserpick.pipeline.projector import highlight_disc, highlight_points, projector_intrinsics
+from laserpick.robot.sim.model import PROJECTOR_CAMERA
+from laserpick.robot.sim.sensors import CAM_TO_OPTICAL
 from laserpick.transforms import make_transform, pinhole_intrinsics
+from laserpick.types import Projector
 
 W, H = dims.PROJECTOR_WIDTH, dims.PROJECTOR_HEIGHT
 

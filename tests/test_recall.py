@@ -32,11 +32,11 @@ from laserpick.pipeline.recall import (
     motion,
     on_target,
 )
-from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
 from laserpick.server.session import Actor, Session, TaskState
 from laserpick.transforms import invert, planar_pose
+from laserpick.types import DepthFrame
 
 WALL_X = 2.0  #: m, in the odometry's frame: a wall facing the scooter's start, in part
 #: within the arm's reach

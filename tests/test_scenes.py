@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from laserpick.robot.objects import (
+from laserpick.robot.sim.objects import (
     GRIPPABLE_WIDTH,
     GROUP_OPAQUE,
     GROUP_SPECULAR,
@@ -23,7 +23,7 @@ from laserpick.robot.objects import (
     rest_pose,
     support,
 )
-from laserpick.robot.scenes import (
+from laserpick.robot.sim.scenes import (
     Placement,
     Scene,
     SceneError,

@@ -19,10 +19,10 @@ from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
 from laserpick.pipeline.grasping import UNSEEN_WAYS, GraspSet, plan_first
 from laserpick.pipeline.plan import Searches, joint_path
 from laserpick.pipeline.selection import group
-from laserpick.pipeline.types import Failure, Grasp
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
 from laserpick.settings import get_settings
+from laserpick.types import Failure, Grasp
 
 HOME, UNSTOW, READY = dims.UR5_HOME_Q, dims.UR5_UNSTOW_Q, dims.UR5_READY_Q
 

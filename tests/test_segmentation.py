@@ -21,9 +21,9 @@ from laserpick.pipeline.segment import (
     remove_horizontal_planes,
     segment_target,
 )
-from laserpick.pipeline.types import Failure, FusedCloud, Segmentation
-from laserpick.robot.scenes import parse_scene
+from laserpick.robot.sim.scenes import parse_scene
 from laserpick.settings import PerceptionSettings
+from laserpick.types import Failure, FusedCloud, Segmentation
 
 SETTINGS = PerceptionSettings()
 SEEDS = (1, 2)

@@ -11,8 +11,8 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.pipeline import selection as sel
-from laserpick.pipeline.types import Grasp
 from laserpick.settings import GraspSettings
+from laserpick.types import Grasp
 
 S = GraspSettings()
 

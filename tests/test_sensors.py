@@ -16,12 +16,12 @@ import pytest
 from scipy import ndimage
 
 from laserpick.description import dims
-from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.laser import LaserPointer
-from laserpick.robot.model import ModelInfo, build_sim_spec
-from laserpick.robot.sensors import DepthCameras
+from laserpick.robot.sim.laser import SimLaser
+from laserpick.robot.sim.model import ModelInfo, build_sim_spec
+from laserpick.robot.sim.sensors import DepthCameras
 from laserpick.settings import SensorSettings
 from laserpick.transforms import rotz
+from laserpick.types import DepthFrame
 
 G = mujoco.mjtGeom
 TABLE_POS = np.array([1.5, 0.0, 0.70])
@@ -88,7 +88,7 @@ def noisy(world) -> tuple[list[DepthFrame], list[np.ndarray]]:
 def laser_frames(world) -> dict[str, tuple[list, list[DepthFrame]]]:
     """Frames with the laser on the box's top: one beam, both beams, and off."""
     model, data = world
-    laser = LaserPointer(model)
+    laser = SimLaser(model)
     out = {}
     with DepthCameras(model, NOISY) as cams:
         laser.aim_at(BOX_TOP)
@@ -316,7 +316,7 @@ def test_laser_off_no_saturation(laser_frames):
 
 def test_laser_sky_and_clamping(world):
     model, data = world
-    laser = LaserPointer(model)
+    laser = SimLaser(model)
     assert laser.beams(data) == [] and laser.cast(model, data) == []
     assert not laser.confirm().confirmed  # nothing to confirm while off
     s = laser.aim(0.0, math.radians(25))
@@ -375,10 +375,10 @@ def test_bound_to_one_thread(world):
 
 
 def test_laser_refuses_non_finite_aims_and_keeps_its_state():
-    from laserpick.robot.laser import LaserPointer
-    from laserpick.robot.model import build_sim_model
+    from laserpick.robot.sim.laser import SimLaser
+    from laserpick.robot.sim.model import build_sim_model
 
-    laser = LaserPointer(build_sim_model(None))
+    laser = SimLaser(build_sim_model(None))
     before = laser.aim(0.1, -0.3)
     for bad in ((float("nan"), 0.0), (0.0, float("inf"))):
         with pytest.raises(ValueError, match="finite"):

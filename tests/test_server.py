@@ -23,7 +23,7 @@ from websockets.sync.client import connect
 
 from laserpick.bench.operator import parking_pose
 from laserpick.client import API, ApiError, Client
-from laserpick.robot.scenes import load_scene, scene_config
+from laserpick.robot.sim.scenes import load_scene, scene_config
 from laserpick.server.journal import Journal
 from laserpick.server.wire import decode_cloud
 from laserpick.transforms import invert, planar_pose

@@ -14,9 +14,8 @@ from laserpick.bench.operator import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasping import GraspSet
-from laserpick.pipeline.types import Failure
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
 from laserpick.server.session import (
     PLACED_NOT_STANDING,
     PUT_BACK,
@@ -25,6 +24,7 @@ from laserpick.server.session import (
     Session,
     TaskState,
 )
+from laserpick.types import Failure
 
 
 def test_a_click_confirmed_mark_is_perceived_in_the_cloud_it_was_aimed_in() -> None:

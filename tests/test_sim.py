@@ -12,9 +12,9 @@ import pytest
 from laserpick.description import dims
 from laserpick.description import kinematics as K
 from laserpick.pipeline.timing import time_parametrize
-from laserpick.pipeline.trajectory import GripperEvent, Trajectory
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim import Simulation
+from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.scenes import load_scene
+from laserpick.types import GripperEvent, Trajectory
 
 
 @pytest.fixture
@@ -176,7 +176,7 @@ def test_a_can_laid_on_its_side_stays_on_its_table():
     kitchen's 73 cm table crept into a roll and was off the table within a minute."""
     import yaml
 
-    from laserpick.robot.scenes import parse_scene, scene_config
+    from laserpick.robot.sim.scenes import parse_scene, scene_config
 
     config = scene_config("kitchen")
     for obj in config["objects"]:
@@ -197,7 +197,7 @@ def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
     """`_contacts` gives the normal force on our geom: an object resting on its table is pushed up
     by its weight. `_felt` adds forces as vectors within a body (a finger pressed from both
     sides at once feels nothing net) and their sizes across bodies."""
-    from laserpick.robot.sim import Contact
+    from laserpick.robot.sim.loop import Contact
 
     sim.settle(1.0)
     m = sim.model

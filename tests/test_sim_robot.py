@@ -10,8 +10,8 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.robot.interface import Robot
-from laserpick.robot.scenes import load_scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
 
 
 @pytest.fixture(scope="module")

@@ -14,8 +14,8 @@ from laserpick.pipeline.surface import (
     still_standing,
     surface_height,
 )
-from laserpick.pipeline.types import Failure, FusedCloud
 from laserpick.settings import PerceptionSettings
+from laserpick.types import Failure, FusedCloud
 
 SETTINGS = PerceptionSettings()
 BEHIND_EDGE = 0.25  # m: where on each surface the height is asked for

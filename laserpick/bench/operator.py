@@ -21,8 +21,8 @@ from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse
-from laserpick.robot.scenes import Surface, scene_config
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import Surface, scene_config
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 
 #: Hand tremor: the aim's angular noise, standard deviation (rad). About 5 mm at 1 m, a

@@ -22,9 +22,8 @@ import numpy as np
 
 from laserpick.bench.operator import TREMOR_STD, Referee
 from laserpick.description import dims
-from laserpick.pipeline.types import Failure
-from laserpick.robot.scenes import Scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import Scene
 from laserpick.server.session import (
     HOLDING_STATES,
     Actor,
@@ -34,6 +33,7 @@ from laserpick.server.session import (
     TaskState,
 )
 from laserpick.settings import Settings, get_settings
+from laserpick.types import Failure
 
 BENCH = Actor("bench")
 #: Marks the operator makes again after the mark itself failed (the dots missed, or no object

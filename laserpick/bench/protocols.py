@@ -58,9 +58,8 @@ from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasping import UNSEEN_WAYS
-from laserpick.pipeline.types import Failure
-from laserpick.robot.objects import LIBRARY, ObjectModel, footprint_half_extents, rest_pose
-from laserpick.robot.scenes import (
+from laserpick.robot.sim.objects import LIBRARY, ObjectModel, footprint_half_extents, rest_pose
+from laserpick.robot.sim.scenes import (
     Scene,
     SceneError,
     Surface,
@@ -70,6 +69,7 @@ from laserpick.robot.scenes import (
 )
 from laserpick.server.session import HOLDING_STATES, Selection, StrategyName, TaskState
 from laserpick.transforms import matrix_from_quat, planar_pose
+from laserpick.types import Failure
 
 #: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until
 #: retrieved; in section 8.3 a task could take more than one pick-and-place attempt, 150

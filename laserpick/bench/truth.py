@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from laserpick.pipeline.types import DepthFrame, FusedCloud
-from laserpick.robot.scenes import Scene, load_scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import Scene, load_scene
+from laserpick.types import DepthFrame, FusedCloud
 
 
 @dataclass

@@ -38,12 +38,11 @@ import viser
 
 from laserpick.description import dims
 from laserpick.pipeline.cloud import ray_distance, voxel_first
-from laserpick.pipeline.projector import Projector
 from laserpick.pipeline.reach import pregrasp_pose
-from laserpick.pipeline.types import FusedCloud, Grasp
 from laserpick.server.lease import CONSOLE, LeaseHeld
 from laserpick.server.session import Actor, Conflict, Session, TaskState
 from laserpick.transforms import planar_pose
+from laserpick.types import FusedCloud, Grasp, Projector
 
 log = logging.getLogger(__name__)
 

@@ -11,7 +11,7 @@ Frames and units: node poses are in `world` (z up), metres; quaternions are (w, 
 order both MuJoCo and viser use.
 
 Visible geoms are groups 0..3 (opaque, robot, transparent, specular; see
-`laserpick.robot.objects`). Group 5 (sites, markers) and anything above is not drawn. The
+`laserpick.robot.sim.objects`). Group 5 (sites, markers) and anything above is not drawn. The
 floor plane is drawn as a large thin box with a grid on top.
 
 The update thread reads `Simulation.snapshot()` only; it never touches MjData.
@@ -31,7 +31,7 @@ import numpy as np
 import trimesh
 import viser
 
-from laserpick.robot.sim import Simulation, Snapshot
+from laserpick.robot.sim.loop import Simulation, Snapshot
 
 log = logging.getLogger(__name__)
 

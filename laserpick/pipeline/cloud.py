@@ -18,8 +18,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from laserpick.pipeline.types import DepthFrame, FusedCloud
 from laserpick.settings import PerceptionSettings, get_settings
+from laserpick.types import DepthFrame, FusedCloud
 
 #: A neighbour whose depth differs by more than this fraction of the pixel's depth lies across
 #: a depth edge, where the finite-difference normal means nothing.

@@ -31,7 +31,7 @@ from laserpick.description.dims import ARM_MOUNT_POS, UR5_D, UR5_HOME_Q, UR5_UNS
 from laserpick.description.kinematics import T_FLANGE_TCP
 from laserpick.pipeline.cloud import voxel_first
 from laserpick.pipeline.free_space import seen_free
-from laserpick.pipeline.types import DepthFrame
+from laserpick.types import DepthFrame
 
 
 @dataclass(frozen=True)

@@ -16,9 +16,9 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
-from laserpick.pipeline.types import DepthFrame, Grasp
 from laserpick.settings import GraspSettings
 from laserpick.transforms import pinhole_project
+from laserpick.types import DepthFrame, Grasp
 
 #: Where the free-space test probes each finger, as fractions: across its width (hand axis,
 #: of finger_width / 2 either side of its middle) and down its length (of finger_length,

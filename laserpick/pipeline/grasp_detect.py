@@ -47,8 +47,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from laserpick.pipeline.cloud import voxel_first
-from laserpick.pipeline.types import Grasp
 from laserpick.settings import GraspSettings, get_settings
+from laserpick.types import Grasp
 
 BINS_PER_PLACEMENT = 4  #: closing-axis bins per finger-placement step (collision resolution)
 SAMPLE_CHUNK = 100  #: samples per block of slab_pairs' coordinate matrix

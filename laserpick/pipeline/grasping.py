@@ -48,8 +48,8 @@ from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled
 from laserpick.pipeline.selection import GraspClusters, group, score
 from laserpick.pipeline.surface import surface_height
-from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import MotionSettings, Settings, get_settings
+from laserpick.types import Failure, Grasp
 
 Strategy = Literal["gpd", "overhead", "vertical"]
 VERTICAL_BITE = 0.02  #: m the fingertips of a vertical grasp reach below the object's top

@@ -49,9 +49,9 @@ import numpy as np
 from scipy import ndimage
 from scipy.cluster.hierarchy import fcluster, linkage
 
-from laserpick.pipeline.types import DepthFrame, Failure, LaserMark
 from laserpick.settings import PerceptionSettings, get_settings
 from laserpick.transforms import pinhole_project
+from laserpick.types import DepthFrame, Failure, LaserMark
 
 KIND = "detect_laser"
 #: Fewest valid depths a window must hold before its median is trusted.

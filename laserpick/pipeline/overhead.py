@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from laserpick.pipeline.types import Failure, Grasp
 from laserpick.settings import GraspSettings, get_settings
+from laserpick.types import Failure, Grasp
 
 GRID_CELL = 0.01  #: m, EL-E's 2D occupancy grid resolution (000 section 4.4.1)
 RAISED_BAND = 0.005  #: m, "less than 5 mm below the point of maximum height" (000 4.4.2)

@@ -16,8 +16,8 @@ import numpy as np
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark, direct_mark
 from laserpick.pipeline.segment import segment_target
-from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, LaserMark, Segmentation
 from laserpick.settings import PerceptionSettings, get_settings
+from laserpick.types import DepthFrame, Failure, FusedCloud, LaserMark, Segmentation
 
 T = TypeVar("T")
 SegmentationMethod = Literal["cluster", "grid"]

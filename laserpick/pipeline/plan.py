@@ -25,9 +25,8 @@ from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.timing import time_parametrize
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import Failure
 from laserpick.settings import MotionSettings, get_settings
+from laserpick.types import Failure, Trajectory
 
 #: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
 #: step means the IK jumped branches (a singularity), so the line is not followed.

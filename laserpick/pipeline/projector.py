@@ -11,17 +11,12 @@ y down, z out of the lens), and K uses pixel centres at integer coordinates, lik
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from laserpick.transforms import pinhole_project
+from laserpick.types import Projector
 
-#: Nearer than this (m) along the optical axis a point is not drawn: it is behind the lens or
-#: too close to light meaningfully.
-NEAR = 0.05
 #: Bounds (px) on the splat radius chosen from the projected point spacing.
 MIN_RADIUS_PX, MAX_RADIUS_PX = 1, 8
 
@@ -45,23 +40,6 @@ def projector_intrinsics(
     cx = w * X / W - 0.5
     cy = h * Y / H - 0.5
     return np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]])
-
-
-@dataclass(frozen=True)
-class Projector:
-    """A projector as a virtual camera: K (3x3, px), T_base_proj (4x4, optical frame in
-    `base`, OpenCV convention), and its image size in pixels."""
-
-    K: np.ndarray
-    T_base_proj: np.ndarray
-    width: int
-    height: int
-
-    def project(self, points_base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Pixel coordinates (N, 2) (u, v) of `points_base` (N, 3) m, and a mask of the points
-        in front of the lens (z > NEAR m); coordinates of the others are meaningless."""
-        uv, _, front = pinhole_project(points_base, self.K, self.T_base_proj, NEAR)
-        return uv, front
 
 
 def _splat_radius(pixels: np.ndarray) -> int:

@@ -19,7 +19,7 @@ import numpy as np
 from laserpick.description.dims import UR5_Q_MAX
 from laserpick.description.kinematics import ik_tcp, wrap
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.types import Grasp
+from laserpick.types import Grasp
 
 #: Largest joint change (rad) between a grasp's and its pre-grasp's solutions: more means the
 #: IK branch flipped, and the straight approach between them would not be straight.

@@ -31,9 +31,9 @@ from scipy.spatial import cKDTree
 from laserpick.pipeline.cloud import fuse, voxel_first
 from laserpick.pipeline.collision import not_carried, self_filter, within_reach
 from laserpick.pipeline.free_space import hidden
-from laserpick.pipeline.types import DepthFrame
 from laserpick.settings import PerceptionSettings, get_settings
 from laserpick.transforms import invert, planar_pose
+from laserpick.types import DepthFrame
 
 #: Voxel (m) a view's points are thinned to: the planner's own (`CollisionChecker`).
 VIEW_VOXEL = 0.01

@@ -26,8 +26,8 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from laserpick.pipeline.surface import surface_height, voi_mask
-from laserpick.pipeline.types import Failure, FusedCloud, Segmentation, SupportSurface
 from laserpick.settings import PerceptionSettings
+from laserpick.types import Failure, FusedCloud, Segmentation, SupportSurface
 
 #: What the user hears. Nothing standing at a mark on a surface is also what a clear glass or
 #: plastic object looks like to depth cameras (the beam and their light pass through it).

@@ -15,8 +15,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
-from laserpick.pipeline.types import Grasp, GraspScores
 from laserpick.settings import GraspSettings, get_settings
+from laserpick.types import Grasp, GraspScores
 
 
 def width_factor(width: float, s: GraspSettings) -> float:

@@ -12,8 +12,8 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from laserpick.pipeline.types import Failure, FusedCloud
 from laserpick.settings import PerceptionSettings
+from laserpick.types import Failure, FusedCloud
 
 #: 8-connectivity in a 2D grid (000 4.3.2).
 _EIGHT = np.ones((3, 3), bool)

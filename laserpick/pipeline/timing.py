@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from laserpick.pipeline.trajectory import GripperEvent, Trajectory
+from laserpick.types import GripperEvent, Trajectory
 
 
 def segment_durations(

@@ -1,22 +1,69 @@
 """The `Robot` interface: the one seam between laserpick and hardware.
 
-The simulated robot implements it; a driver for a real UR5 on a real scooter would implement
-the same methods, and nothing above robot/ would change. Everything it returns is something
-real sensors and controllers report: frames, joint state, gripper state, wheel odometry.
+The simulated robot (`robot.sim`) and the recorded robot (`robot.recorded`) implement it; a
+driver for a real UR5 on a real scooter would implement the same methods, and nothing above
+robot/ would change. Everything it returns is something real sensors and controllers report:
+frames, joint state, gripper state, wheel odometry, the pointer's aim.
+
+Units are SI (m, rad, s, N); poses and points are in `base` unless a name says `world`.
 """
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.sim import PROTECTIVE_STOP, MotionHandle
+from laserpick.robot.pointer import LaserState
+from laserpick.types import DepthFrame, Projector, Trajectory
 
-__all__ = ["PROTECTIVE_STOP", "GripperState", "JointState", "MotionHandle", "Robot"]
+__all__ = [
+    "PROTECTIVE_STOP",
+    "GripperState",
+    "JointState",
+    "LaserPointer",
+    "LaserState",
+    "MotionHandle",
+    "MotionStatus",
+    "Robot",
+    "RobotState",
+]
+
+MotionStatus = Literal["running", "done", "stopped", "failed"]
+
+#: How a motion's message begins when the arm's controller made a protective stop (it met a
+#: force over `dims.UR5_PROTECTIVE_STOP_FORCE`), as a UR controller reports one.
+PROTECTIVE_STOP = "protective stop: "
+
+
+class MotionHandle:
+    """The outcome of one commanded arm motion, shared between the caller and the controller.
+
+    The robot's controller calls `finish` once; later calls are ignored.
+    """
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        self.status: MotionStatus = "running"
+        self.message = ""
+        self._done = threading.Event()
+
+    def finish(self, status: MotionStatus, message: str = "") -> None:
+        """End the motion with `status` and a sentence saying why (for stopped or failed)."""
+        if self._done.is_set():
+            return
+        self.status, self.message = status, message
+        self._done.set()
+
+    def done(self) -> bool:
+        return self._done.is_set()
+
+    def wait(self, timeout: float | None = None) -> MotionStatus:
+        """Block until the motion ends (or `timeout` seconds of wall time pass)."""
+        self._done.wait(timeout)
+        return self.status
 
 
 @dataclass(frozen=True)
@@ -38,8 +85,59 @@ class GripperState:
     holding: bool
 
 
+@dataclass(frozen=True)
+class RobotState:
+    """One consistent reading of everything the robot reports, for status displays.
+
+    stamp: robot time (s). base_pose: odometry (x, y, yaw) in m and rad since start.
+    base_velocity: forward speed (m/s) and turn rate (rad/s). estopped: the e-stop is latched.
+    moving: an arm motion is in progress. drive_stop: why the base last stopped itself, or "".
+    rtf: robot seconds per wall second (1.0 for hardware and for a simulator keeping up).
+    """
+
+    stamp: float
+    joints: JointState
+    gripper: GripperState
+    base_pose: np.ndarray
+    base_velocity: np.ndarray
+    estopped: bool
+    moving: bool
+    drive_stop: str
+    rtf: float
+
+
+class LaserPointer(Protocol):
+    """The dual-beam pointer on the scooter (`robot.pointer.DualBeamPointer` keeps the aim)."""
+
+    @property
+    def state(self) -> LaserState: ...
+
+    def aim(self, yaw: float, pitch: float) -> LaserState:
+        """Light the aiming beam at (yaw, pitch) rad in `base`, clamped to the pointer's limits."""
+        ...
+
+    def aim_at(self, point_base: np.ndarray) -> LaserState: ...
+
+    def nudge(self, dyaw: float, dpitch: float) -> LaserState: ...
+
+    def confirm(self) -> LaserState:
+        """Light the second beam (does nothing while off)."""
+        ...
+
+    def off(self) -> LaserState: ...
+
+    def beams_base(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(origin m, unit direction) in `base` of each lit beam."""
+        ...
+
+
 class Robot(Protocol):
-    """What laserpick needs from a robot, simulated or real."""
+    """What laserpick needs from a robot, simulated, recorded or real."""
+
+    laser: LaserPointer
+    #: True when robot time runs with the wall clock (hardware, the live simulator); False when
+    #: the caller advances it (`wait` and `sleep` step a headless simulator, deterministically).
+    realtime: bool
 
     def capture(self) -> list[DepthFrame]:
         """Depth and IR frames from every depth sensor, with intrinsics and extrinsics."""
@@ -51,6 +149,14 @@ class Robot(Protocol):
 
     def base_pose(self) -> np.ndarray:
         """Odometry: the scooter's (x, y, yaw) on the floor (m, rad) since start."""
+        ...
+
+    def state(self) -> RobotState:
+        """Everything above in one consistent reading, with the e-stop and pacing."""
+        ...
+
+    def projector(self) -> Projector:
+        """The scooter's projector as a virtual camera in `base` (its calibration)."""
         ...
 
     def execute(self, traj: Trajectory) -> MotionHandle:
@@ -82,3 +188,7 @@ class Robot(Protocol):
         ...
 
     def reset_stop(self) -> None: ...
+
+    def close(self) -> None:
+        """Release the hardware (threads, sensors, connections)."""
+        ...

@@ -38,7 +38,7 @@ from laserpick import __version__
 from laserpick.bench.operator import Referee
 from laserpick.console.view_page import view_page
 from laserpick.pipeline.cloud import voxel_downsample
-from laserpick.robot.scenes import SceneError, load_scene, parse_scene
+from laserpick.robot.sim.scenes import SceneError, load_scene, parse_scene
 from laserpick.server import schemas as S
 from laserpick.server.lease import LeaseHeld
 from laserpick.server.session import Actor, Conflict, Session

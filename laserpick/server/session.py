@@ -55,13 +55,13 @@ from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.recall import Recalled, ViewMemory, moved, moved_points
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.pipeline.surface import still_standing
-from laserpick.pipeline.types import DepthFrame, Failure, FusedCloud, Grasp
-from laserpick.robot.scenes import Scene
-from laserpick.robot.sim_robot import SimRobot
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import Scene
 from laserpick.server.journal import Journal
 from laserpick.server.lease import ControlLease
 from laserpick.settings import Settings, get_settings
 from laserpick.transforms import invert, planar_pose
+from laserpick.types import DepthFrame, Failure, FusedCloud, Grasp
 
 log = logging.getLogger(__name__)
 

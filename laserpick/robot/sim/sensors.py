@@ -5,7 +5,7 @@ which gives, from one pass, the z-buffer (metric depth) and a geom id per pixel.
 fitted loosely to structured-light sensors (Occipital Structure) then turns the exact depth
 into what the pipeline gets, and an IR intensity image is synthesised with the laser dots in it.
 
-What the sensors see, by geom group (see `laserpick.robot.objects`):
+What the sensors see, by geom group (see `laserpick.robot.sim.objects`):
 
 * 0 surfaces and opaque objects, 1 the robot: seen, with noise.
 * 2 transparent objects: not seen at all. Structured light passes through clear plastic, so
@@ -59,11 +59,11 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.model import SCOOTER_BODY, depth_intrinsics
-from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR, GROUP_TRANSPARENT
+from laserpick.robot.sim.model import SCOOTER_BODY, depth_intrinsics
+from laserpick.robot.sim.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR, GROUP_TRANSPARENT
 from laserpick.settings import SensorSettings, get_settings
 from laserpick.transforms import invert, make_transform, pinhole_intrinsics
+from laserpick.types import DepthFrame
 
 #: Geom groups the depth sensor sees: surfaces/opaque (0), robot (1), specular (3).
 DEPTH_GEOMGROUP = tuple(int(g in (GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR)) for g in range(6))
@@ -232,7 +232,7 @@ class DepthCameras:
     ) -> list[DepthFrame]:
         """One frame per camera, in `dims.CAMERA_MOUNTS` order, at joint positions `qpos`.
 
-        laser_hits: world points (m) where lit beams land (`LaserPointer.cast`); each is drawn
+        laser_hits: world points (m) where lit beams land (`SimLaser.cast`); each is drawn
         into the IR image of every camera that sees it. None entries are skipped.
         """
         return self._capture(qpos, stamp, laser_hits, labels=False)[0]
@@ -485,14 +485,14 @@ class DepthCameras:
 
 
 def _demo(scene_name: str | None = "isolation", n: int = 10) -> None:
-    """Time full 5-camera captures: `MUJOCO_GL=egl python -m laserpick.robot.sensors [scene]`."""
+    """Time full 5-camera captures: `python -m laserpick.robot.sim.sensors [scene]`."""
     import time
 
-    from laserpick.robot.model import ModelInfo, build_sim_model
+    from laserpick.robot.sim.model import ModelInfo, build_sim_model
 
     scene = None
     if scene_name:
-        from laserpick.robot.scenes import load_scene
+        from laserpick.robot.sim.scenes import load_scene
 
         scene = load_scene(scene_name)
     model = build_sim_model(scene)

@@ -15,17 +15,15 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.pipeline.projector import Projector
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.pipeline.types import DepthFrame
-from laserpick.robot.interface import GripperState, JointState
-from laserpick.robot.laser import LaserPointer
-from laserpick.robot.model import camera_rotation
-from laserpick.robot.scenes import Scene
-from laserpick.robot.sensors import CAM_TO_OPTICAL, DepthCameras
-from laserpick.robot.sim import MotionHandle, Simulation, Snapshot
+from laserpick.robot.interface import GripperState, JointState, MotionHandle, RobotState
+from laserpick.robot.sim.laser import SimLaser
+from laserpick.robot.sim.loop import Simulation, Snapshot
+from laserpick.robot.sim.model import camera_rotation
+from laserpick.robot.sim.scenes import Scene
+from laserpick.robot.sim.sensors import CAM_TO_OPTICAL, DepthCameras
 from laserpick.settings import Settings, get_settings
 from laserpick.transforms import make_transform, pinhole_intrinsics
+from laserpick.types import DepthFrame, Projector, Trajectory
 
 
 class SimRobot:
@@ -36,7 +34,7 @@ class SimRobot:
     ) -> None:
         self.settings = settings or get_settings()
         self.sim = Simulation(scene, realtime=realtime, settings=self.settings)
-        self.laser = LaserPointer(self.sim.model)
+        self.laser = SimLaser(self.sim.model)
         self._laser_lock = threading.Lock()
         self._capture_pool = ThreadPoolExecutor(
             max_workers=1, thread_name_prefix="laserpick-capture"
@@ -48,6 +46,10 @@ class SimRobot:
     @property
     def model(self) -> mujoco.MjModel:
         return self.sim.model
+
+    @property
+    def realtime(self) -> bool:
+        return self.sim.realtime
 
     def close(self) -> None:
         self.sim.close()
@@ -93,6 +95,25 @@ class SimRobot:
 
     def base_pose(self) -> np.ndarray:
         return self.sim.snapshot().base_pose.copy()
+
+    def state(self) -> RobotState:
+        s = self.sim.snapshot()
+        return RobotState(
+            stamp=s.time,
+            joints=JointState(q=s.arm_q.copy(), qd=s.arm_qd.copy(), stamp=s.time),
+            gripper=GripperState(
+                width=s.gripper_width,
+                force=s.gripper_force,
+                closed=s.gripper_closed,
+                holding=s.holding,
+            ),
+            base_pose=s.base_pose.copy(),
+            base_velocity=s.base_velocity.copy(),
+            estopped=s.estopped,
+            moving=s.moving,
+            drive_stop=s.drive_stop,
+            rtf=s.rtf,
+        )
 
     # --- acting -----------------------------------------------------------------------------------
 

@@ -1,15 +1,36 @@
-"""Core data types that cross the robot/pipeline seam.
+"""The values every room shares: what a robot's sensors and controllers produce, and what the
+pipeline hands back. `robot/` and `pipeline/` both import this module and never each other.
 
-Everything here is what a real robot's sensors could produce: images, intrinsics,
-extrinsics, joint state. Nothing here carries simulator ground truth.
+Nothing here carries simulator ground truth. Units are SI; points and poses are in `base`
+(x forward, y left, z up, origin on the floor under the rear axle) unless a field says otherwise.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
+
+from laserpick.transforms import pinhole_project
+
+__all__ = [
+    "DepthFrame",
+    "Failure",
+    "FailureKind",
+    "FusedCloud",
+    "Grasp",
+    "GraspScores",
+    "GripperAction",
+    "GripperEvent",
+    "LaserMark",
+    "MarkState",
+    "Projector",
+    "SegmentMethod",
+    "Segmentation",
+    "SupportSurface",
+    "Trajectory",
+]
 
 
 @dataclass(frozen=True)
@@ -199,3 +220,74 @@ class Grasp:
     @property
     def score(self) -> float:
         return self.scores.total if self.scores is not None else 0.0
+
+
+GripperAction = Literal["open", "close"]
+
+
+@dataclass(frozen=True)
+class GripperEvent:
+    """Open or close the gripper `t` seconds after the trajectory starts."""
+
+    t: float
+    action: GripperAction
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Arm joint positions over time.
+
+    times: (T,) seconds from the start, strictly increasing, times[0] == 0.
+    q: (T, 6) joint angles (rad) of the UR5, shoulder_pan .. wrist_3.
+    gripper: events fired when the trajectory clock passes their time.
+    guard_force: if set, the robot stops the motion (and reports it failed) as soon as the
+    contact force on the arm or the gripper exceeds this many newtons: a guarded move.
+    """
+
+    times: np.ndarray
+    q: np.ndarray
+    gripper: tuple[GripperEvent, ...] = field(default_factory=tuple)
+    guard_force: float | None = None
+
+    def __post_init__(self) -> None:
+        t, q = np.asarray(self.times, float), np.asarray(self.q, float)
+        if t.ndim != 1 or q.shape != (len(t), 6) or len(t) < 1:
+            raise ValueError(f"trajectory needs times (T,) and q (T, 6); got {t.shape}, {q.shape}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(q))):
+            raise ValueError("trajectory contains non-finite values")
+        if self.guard_force is not None and not self.guard_force > 0:
+            raise ValueError(f"guard_force must be positive, got {self.guard_force}")
+        if abs(t[0]) > 1e-12 or np.any(np.diff(t) <= 0):
+            raise ValueError("trajectory times must start at 0 and strictly increase")
+        object.__setattr__(self, "times", t)
+        object.__setattr__(self, "q", q)
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1])
+
+    def sample(self, t: float) -> np.ndarray:
+        """Joint angles at time t (s), linearly interpolated and held at the ends."""
+        return np.array([np.interp(t, self.times, self.q[:, j]) for j in range(6)])
+
+
+#: Nearer than this (m) along the optical axis a point is not drawn: it is behind the lens or
+#: too close to light meaningfully.
+NEAR = 0.05
+
+
+@dataclass(frozen=True)
+class Projector:
+    """A projector as a virtual camera: K (3x3, px), T_base_proj (4x4, optical frame in
+    `base`, OpenCV convention), and its image size in pixels."""
+
+    K: np.ndarray
+    T_base_proj: np.ndarray
+    width: int
+    height: int
+
+    def project(self, points_base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates (N, 2) (u, v) of `points_base` (N, 3) m, and a mask of the points
+        in front of the lens (z > NEAR m); coordinates of the others are meaningless."""
+        uv, _, front = pinhole_project(points_base, self.K, self.T_base_proj, NEAR)
+        return uv, front

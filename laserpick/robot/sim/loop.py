@@ -20,55 +20,28 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.pipeline.trajectory import Trajectory
-from laserpick.robot.arm_control import CartesianController, TrajectoryTracker
-from laserpick.robot.model import ModelInfo, build_arm_model, build_sim_model
-from laserpick.robot.scenes import Scene
+from laserpick.robot.interface import PROTECTIVE_STOP, MotionHandle, MotionStatus
+from laserpick.robot.sim.arm_control import CartesianController, TrajectoryTracker
+from laserpick.robot.sim.model import ModelInfo, build_arm_model, build_sim_model
+from laserpick.robot.sim.scenes import Scene
 from laserpick.settings import Settings, get_settings
+from laserpick.types import Trajectory
 
 log = logging.getLogger(__name__)
 
-MotionStatus = Literal["running", "done", "stopped", "failed"]
-
 #: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
 _CHUNK_STEPS = 10
-#: How a motion's message begins when a protective stop ended it.
-PROTECTIVE_STOP = "protective stop: "
 #: What a console says when the scooter stops itself; what the arm met follows.
 DRIVE_STOP = "The scooter stopped: driving pushed the arm into something. Drive back to free it"
 #: s of driving without being stopped again before that notice is taken down: the stick held
 #: against the push stops the scooter every few steps, and the notice must not flicker.
 DRIVE_STOP_CLEARS = 0.5
-
-
-class MotionHandle:
-    """The outcome of one commanded arm motion, shared between the caller and the sim thread."""
-
-    def __init__(self, kind: str) -> None:
-        self.kind = kind
-        self.status: MotionStatus = "running"
-        self.message = ""
-        self._done = threading.Event()
-
-    def _finish(self, status: MotionStatus, message: str = "") -> None:
-        if self._done.is_set():
-            return
-        self.status, self.message = status, message
-        self._done.set()
-
-    def done(self) -> bool:
-        return self._done.is_set()
-
-    def wait(self, timeout: float | None = None) -> MotionStatus:
-        """Block until the motion ends (or `timeout` seconds of wall time pass)."""
-        self._done.wait(timeout)
-        return self.status
 
 
 @dataclass(frozen=True)
@@ -228,7 +201,7 @@ class Simulation:
                 return
             start = self.data.qpos[self.info.arm_qpos]
             if np.max(np.abs(traj.q[0] - start)) > 0.05:
-                handle._finish("failed", "trajectory does not start at the current joint angles")
+                handle.finish("failed", "trajectory does not start at the current joint angles")
                 return
             self._replace_motion(TrajectoryTracker(traj, self.data.time), handle)
 
@@ -246,7 +219,7 @@ class Simulation:
             try:
                 self._cartesian.set_target(target)
             except ValueError as exc:
-                handle._finish("failed", str(exc))
+                handle.finish("failed", str(exc))
                 return
             self._cart_deadline = self.data.time + timeout
             self._replace_motion(self._cartesian, handle)
@@ -454,7 +427,7 @@ class Simulation:
         self, motion: TrajectoryTracker | CartesianController, handle: MotionHandle
     ) -> None:
         if self._handle is not None:
-            self._handle._finish("stopped", "replaced by a new motion")
+            self._handle.finish("stopped", "replaced by a new motion")
         self._motion, self._handle = motion, handle
         self._q_set = self.data.qpos[self.info.arm_qpos].copy()
 
@@ -487,7 +460,7 @@ class Simulation:
 
     def _end_motion(self, status: MotionStatus, message: str = "") -> None:
         if self._handle is not None:
-            self._handle._finish(status, message)
+            self._handle.finish(status, message)
         self._motion, self._handle = None, None
 
     def _stopped_by_contact(self, guard_force: float | None) -> bool:
@@ -525,7 +498,7 @@ class Simulation:
 
     def _refuse_when_stopped(self, handle: MotionHandle) -> bool:
         if self.estopped:
-            handle._finish("failed", "e-stop is latched; reset it first")
+            handle.finish("failed", "e-stop is latched; reset it first")
             return True
         return False
 

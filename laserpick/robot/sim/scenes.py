@@ -64,7 +64,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from laserpick.description import dims
-from laserpick.robot.objects import (
+from laserpick.robot.sim.objects import (
     GROUP_OPAQUE,
     LIBRARY,
     SURFACE_CONAFFINITY,

@@ -15,9 +15,9 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.pipeline.trajectory import GripperEvent, Trajectory
-from laserpick.robot.model import ARM_JOINTS, ARM_PREFIX, SCOOTER_COLLISION_PREFIX, TCP_SITE
+from laserpick.robot.sim.model import ARM_JOINTS, ARM_PREFIX, SCOOTER_COLLISION_PREFIX, TCP_SITE
 from laserpick.transforms import rotation_angle
+from laserpick.types import GripperEvent, Trajectory
 
 
 class TrajectoryTracker:

@@ -1,24 +1,14 @@
-"""The dual laser pointer the seated user holds (paper 004, section 4.3 and 5.2).
+"""The dual laser pointer's aim (paper 004, sections 4.3 and 5.2), without its hardware.
 
-Two parallel red beams `dims.LASER_BEAM_SEPARATION` apart. The user aims with one beam lit
-("aiming") and lights the second to confirm the selection ("confirmed"). Here the pointer is
-a pair of rays from the model site `laser/origin`, which rides on the scooter, so the pointer
-is aimed in `base` and moves with the scooter.
+Two parallel beams `dims.LASER_BEAM_SEPARATION` apart leave `origin_base`, which rides on the
+scooter. The user aims with one beam lit ("aiming") and lights the second to confirm
+("confirmed"). Aim: yaw about +z of `base`, from +x, positive left; pitch above the horizontal,
+positive up; both in radians and clamped to the `dims.LASER_*` limits. The second beam leaves a
+point `LASER_BEAM_SEPARATION` to the first beam's left (horizontal, perpendicular to the beam)
+and runs parallel to it.
 
-Aim: yaw about +z of `base`, measured from +x (positive turns left), and pitch above the
-horizontal (positive up), both in radians and clamped to the `dims.LASER_*` limits. The
-first beam leaves the origin; the second leaves a point `LASER_BEAM_SEPARATION` to the
-beam's left (horizontal, perpendicular to the beam) and runs parallel to it.
-
-What the beams hit: `mujoco.mj_ray` against geom groups 0 (surfaces, opaque objects),
-1 (robot) and 3 (specular objects), excluding the scooter body's own shell (the user points
-past the tiller and basket, not at them). Group 2 (transparent objects) is ignored on
-purpose: a 650 nm beam mostly passes through clear plastic and glass, and the spot a camera
-sees is where it lands behind, on the table. The depth sensor does not see group 2 either, so
-the spot and the depth it is deprojected with agree. The arm is not excluded: a beam that
-hits the arm lands on the arm.
-
-Plain state, no locks: one `LaserPointer` lives on the simulation thread.
+A driver for a real pan-tilt pointer, the simulator and a recorded robot all keep their aim
+here; what differs is what the beams land on.
 """
 
 from __future__ import annotations
@@ -28,17 +18,11 @@ import math
 import threading
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.robot.model import LASER_SITE, SCOOTER_BODY
-from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR
 
-#: Geom groups a beam can land on (0, 1, 3); group 2, transparent, lets the beam through.
-LASER_GEOMGROUP = np.array(
-    [int(g in (GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR)) for g in range(6)], dtype=np.uint8
-)
+__all__ = ["DualBeamPointer", "LaserState"]
 
 
 @dataclass(frozen=True)
@@ -51,19 +35,6 @@ class LaserState:
     pitch: float  #: rad above the horizontal, positive up
 
 
-@dataclass(frozen=True)
-class LaserHit:
-    """Where one beam landed: world point (m), its `base` point (m), and the geom it hit.
-
-    The geom id is simulator ground truth: for bench/ and tests, never for the pipeline.
-    """
-
-    point_world: np.ndarray
-    point_base: np.ndarray
-    geom: int
-    distance: float  #: m from the beam's origin
-
-
 def _clamp(x: float, lo: float, hi: float) -> float:
     return min(max(float(x), lo), hi)
 
@@ -74,20 +45,15 @@ def _finite(**values: float) -> None:
             raise ValueError(f"laser {name} must be a finite number, got {v!r}")
 
 
-class LaserPointer:
-    """The simulated dual laser pointer. Starts off, pointing straight ahead and level.
+class DualBeamPointer:
+    """The pointer's aim and beams in `base`. Starts off, pointing straight ahead and level.
 
     Safe to aim from one thread while another casts: the state is one immutable `LaserState`,
     swapped whole under a lock, and every reader works from one snapshot of it.
     """
 
-    def __init__(self, model: mujoco.MjModel) -> None:
-        self._site = model.site(LASER_SITE).id
-        self._body = model.body(SCOOTER_BODY).id
-        if model.site_bodyid[self._site] != self._body:
-            raise ValueError(f"site {LASER_SITE!r} must be fixed to body {SCOOTER_BODY!r}")
-        # The site is a direct child of the scooter body, so its local position is in `base`.
-        self._origin_base = np.array(model.site_pos[self._site], dtype=float)
+    def __init__(self, origin_base: np.ndarray | tuple[float, float, float] = dims.LASER_ORIGIN):
+        self._origin_base = np.array(origin_base, dtype=float).reshape(3)
         self._st = LaserState(on=False, confirmed=False, yaw=0.0, pitch=0.0)
         self._lock = threading.Lock()
 
@@ -171,41 +137,3 @@ class LaserPointer:
             left = np.array([-math.sin(st.yaw), math.cos(st.yaw), 0.0])
             out.append((self._origin_base + dims.LASER_BEAM_SEPARATION * left, d.copy()))
         return out
-
-    def beams(self, data: mujoco.MjData) -> list[tuple[np.ndarray, np.ndarray]]:
-        """(origin m, unit direction) in `world` of each lit beam, at the scooter's pose in data.
-
-        Needs `data.xpos`/`data.xmat` current (after `mj_kinematics` or `mj_forward`).
-        """
-        R = data.xmat[self._body].reshape(3, 3)
-        p = data.xpos[self._body]
-        return [(p + R @ o, R @ d) for o, d in self.beams_base()]
-
-    def cast_hits(self, model: mujoco.MjModel, data: mujoco.MjData) -> list[LaserHit | None]:
-        """Ray-cast each lit beam; a `LaserHit` per beam, None if nothing within range."""
-        R = data.xmat[self._body].reshape(3, 3)
-        p = data.xpos[self._body]
-        geomid = np.array([-1], dtype=np.int32)
-        out: list[LaserHit | None] = []
-        for origin, direction in self.beams(data):
-            dist = mujoco.mj_ray(
-                model,
-                data,
-                origin,
-                direction,
-                LASER_GEOMGROUP,
-                True,  # static geoms too: tables and shelves are static
-                self._body,
-                geomid,
-            )
-            if dist < 0 or dist > dims.LASER_MAX_RANGE:
-                out.append(None)
-                continue
-            hit = origin + dist * direction
-            out.append(LaserHit(hit, R.T @ (hit - p), int(geomid[0]), float(dist)))
-        return out
-
-    def cast(self, model: mujoco.MjModel, data: mujoco.MjData) -> list[np.ndarray | None]:
-        """World hit point (m) of each lit beam, None where nothing lies within
-        `dims.LASER_MAX_RANGE`. Needs the kinematics in `data` current."""
-        return [None if h is None else h.point_world for h in self.cast_hits(model, data)]

@@ -32,8 +32,8 @@ from laserpick.description.collision import (
     POST_RADIUS,
     PROJECTOR_HOUSING_RAISE,
 )
-from laserpick.robot.objects import GROUP_OPAQUE, GROUP_ROBOT
-from laserpick.robot.scenes import Scene, add_scene_to_spec
+from laserpick.robot.sim.objects import GROUP_OPAQUE, GROUP_ROBOT
+from laserpick.robot.sim.scenes import Scene, add_scene_to_spec
 from laserpick.settings import get_settings
 from laserpick.transforms import pinhole_intrinsics, quat_from_matrix, rotx, roty, rotz
 

@@ -1,0 +1,181 @@
+"""Grasp detection and selection (paper 004 section 7, GPD)."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, Field
+
+__all__ = ["GraspSettings"]
+
+
+class GraspSettings(BaseModel):
+    """Grasp selection parameters (paper 004 section 7) and the hand geometry the pipeline uses.
+
+    The hand geometry mirrors the gripper in `laserpick.description.dims` (a test holds them equal);
+    it is repeated here because pipeline/ may not import robot/.
+    """
+
+    width_min: float = Field(0.0, ge=0, description="Gripper's smallest opening W_min (m).")
+    width_max: float = Field(0.085, gt=0, description="Gripper's stroke W_max (m). 2F-85.")
+    finger_length: float = Field(
+        0.05, gt=0, description="Finger length l, the reach of Cs (m). Eq. 6 of 004."
+    )
+    width_margin: float = Field(
+        0.015, ge=0, description="W_d, the distance kept from the stroke's ends (m). 004 eq. 3."
+    )
+    joint_distance_max: float = Field(
+        7.695,
+        gt=0,
+        description=(
+            "J_m of 004 eq. 4 (rad): pi * sqrt(6), the largest joint-space distance between two"
+            " configurations once each joint's difference is wrapped to [-pi, pi]."
+        ),
+    )
+    mark_distance: float = Field(
+        0.05, ge=0, description="th, the mark distance free of penalty (m). 004 eq. 7."
+    )
+    cluster_distance: float = Field(
+        0.02,
+        gt=0,
+        description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
+    )
+    # Hand geometry for grasp detection (collision boxes); description/dims.py and robot/model.py.
+    pad_depth: float = Field(
+        0.022, gt=0, description="Pad extent along the approach axis (m). description/dims.py."
+    )
+    pad_width: float = Field(
+        0.022, gt=0, description="Pad extent along the hand axis (m). description/dims.py."
+    )
+    pad_thickness: float = Field(
+        0.008, gt=0, description="Pad thickness along the closing axis (m). description/dims.py."
+    )
+    finger_thickness: float = Field(
+        0.008,
+        gt=0,
+        description="Finger plate thickness along the closing axis, outside the pad (m). "
+        "robot/model.py.",
+    )
+    finger_width: float = Field(
+        0.024,
+        gt=0,
+        description="Finger plate extent along the hand axis (m). robot/model.py.",
+    )
+    palm_width: float = Field(
+        0.09, gt=0, description="Palm housing across the closing axis (m). description/dims.py."
+    )
+    palm_depth: float = Field(
+        0.06, gt=0, description="Palm housing along the hand axis (m). description/dims.py."
+    )
+    palm_length: float = Field(
+        0.09,
+        gt=0,
+        description="Palm housing along the approach axis, behind the finger roots (m). "
+        "robot/model.py (GRIPPER_BASE_LENGTH less the 1 cm coupling).",
+    )
+    side_clearance: float = Field(
+        0.004,
+        ge=0,
+        lt=0.02,
+        description="Gap (m) kept between every seen point and the fingers' inner faces and"
+        " sides and the palm's sides: GPD's detector tests a hand this much larger on each"
+        " side, whose opening is this much narrower on each side; a vertical grasp needs the"
+        " object this much narrower than the opening on each side. A depth camera sees a box's"
+        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm;"
+        " with no gap a finger slid down an edge it had missed by 0.4 mm. Ours.",
+    )
+    free_space_tolerance: float = Field(
+        0.006,
+        gt=0,
+        description="A depth reading shows a point free when it lies this far (m) beyond it:"
+        " about three times the sensors' noise at 1.2 m. Ours.",
+    )
+    free_space_share: float = Field(
+        0.9,
+        ge=0,
+        le=1,
+        description="Share of a grasp's finger probes the cameras must have seen free; 0 turns"
+        " the free-space test off. Ours (pipeline/free_space.py).",
+    )
+    # GPD candidate generation (004 section 6.2; ten Pas et al. 2017 and GPD's defaults).
+    gpd_samples: int = Field(
+        500, ge=1, description="Points sampled from the target to seed candidates. GPD default."
+    )
+    gpd_orientations: int = Field(
+        8, ge=1, description="Hand rotations about the curvature axis per sample. GPD default."
+    )
+    gpd_finger_placements: int = Field(
+        10, ge=1, description="Lateral hand offsets along the closing axis per rotation. GPD."
+    )
+    gpd_tilts_deg: tuple[float, ...] = Field(
+        (-60.0, -30.0, 30.0, 60.0),
+        description="Tilts (deg) of the hand about its closing axis, leaning the approach toward"
+        " the curvature axis, tried when no untilted grasp is reachable: a low object lying"
+        " pointed at the robot under a shelf's board is then taken from the front and above,"
+        " across its girth. GPD 2's extra hand axes; ours for the angles.",
+    )
+    gpd_nn_radius: float = Field(
+        0.01,
+        gt=0,
+        description="Neighbourhood radius (m) whose normals give a sample's local frame. GPD.",
+    )
+    gpd_frame_neighbours: int = Field(
+        32, ge=3, description="Most neighbours used for a local frame (speed cap). Ours."
+    )
+    gpd_init_bite: float = Field(
+        0.01,
+        ge=0,
+        description="How far (m) the fingertips reach past the sample before deepening. GPD.",
+    )
+    gpd_clearance: float = Field(
+        0.002,
+        ge=0,
+        description="Gap (m) kept before the first contact when pushing the hand in. Ours.",
+    )
+    gpd_friction_deg: float = Field(
+        20.0,
+        gt=0,
+        lt=90,
+        description="Friction cone half-angle (deg) of the antipodal test. GPD's friction_coeff.",
+    )
+    gpd_contact_band: float = Field(
+        0.003,
+        gt=0,
+        description="Points this close (m) to a finger's extreme contact count as contacts. "
+        "GPD's extremal_thresh.",
+    )
+    gpd_min_contacts: int = Field(
+        6, ge=1, description="Antipodal contact points needed on each side. GPD's min_viable."
+    )
+    gpd_tangent_deg: float = Field(
+        10.0,
+        gt=0,
+        lt=90,
+        description="A pad meets the object along its face where the object's normals at the"
+        " pad's extreme lie within this angle (deg) of the closing axis"
+        " (grasp_detect.closing_region). Ours.",
+    )
+    gpd_patch_offset: float = Field(
+        0.007,
+        ge=0,
+        description="How far (m) along the hand axis the middle of the patch where a pad meets"
+        " the object may lie from the pad's middle for the grasp to count as centred"
+        " (grasp_detect.closing_region), and be offered before those that do not"
+        " (selection.group): a pad that meets it only at its edge lets it spin out. Ours.",
+    )
+    gpd_recentre: float = Field(
+        0.022,
+        ge=0,
+        description="How far (m) past each side of the pads a hand that is not centred"
+        " (gpd_patch_offset) looks for where its pads would meet the object along their face;"
+        " it is tried again turned about its axis and moved along it onto that patch"
+        " (grasp_detect.patch_moves). 0 turns this off. Ours: one pad width.",
+    )
+    gpd_collision_voxel: float = Field(
+        0.0,
+        ge=0,
+        description="The scene around the target is thinned to one point per voxel of this edge"
+        " (m) for the collision test, for speed (2x at 5 mm), at the cost of missing points up"
+        " to a voxel inside a hand box; 0 keeps every point (exact). Ours.",
+    )
+    gpd_min_points: int = Field(
+        10, ge=1, description="Object points needed between the pads. Ours."
+    )
