@@ -77,9 +77,9 @@ def synthetic() -> list[Input]:
 def captured(seeds: list[int]) -> list[Input]:
     """Every object of the `isolation` scene, segmented from one simulated capture per seed."""
     # Imported here so that --synthetic needs no simulator.
-    from laserpick.bench.truth import capture
     from laserpick.pipeline.cloud import fuse
     from laserpick.pipeline.perceive import perceive
+    from laserpick.robot.sim.truth import capture
 
     out = []
     for seed in seeds:

@@ -16,11 +16,11 @@ import time
 
 import numpy as np
 
-from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import GraspSet, find_grasps, plan_first
 from laserpick.pipeline.perceive import perceive
+from laserpick.robot.sim.truth import capture
 from laserpick.types import Failure
 
 STAGES = ("detect", "filter", "select", "plan")

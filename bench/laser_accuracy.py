@@ -13,9 +13,9 @@ import argparse
 
 import numpy as np
 
-from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark
+from laserpick.robot.sim.truth import capture
 from laserpick.types import Failure
 
 

@@ -16,9 +16,9 @@ import time
 
 import numpy as np
 
-from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.perceive import perceive
+from laserpick.robot.sim.truth import capture
 
 #: Paper 004's mean stage times on its workstation (s): Table 4 (in situ). Its Table 2
 #: (isolation) gives 5.8 s for the laser; its acquire figure there is illegible in our copy.

@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 
 import laserpick.pipeline.recall as recall
-from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.robot.sim.truth import capture
 from laserpick.server.session import Actor, Session
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))

@@ -12,9 +12,10 @@ import argparse
 
 import numpy as np
 
-from laserpick.bench.truth import capture, iou
+from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.segment import segment_target
+from laserpick.robot.sim.truth import capture
 from laserpick.settings import get_settings
 from laserpick.types import Failure
 

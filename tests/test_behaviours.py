@@ -33,7 +33,6 @@ from laserpick.behaviours import (
 )
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
-from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -55,6 +54,7 @@ from laserpick.pipeline.surface import still_standing
 from laserpick.robot.sim.loop import DRIVE_STOP
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.robot.sim.truth import Captured
 from laserpick.transforms import matrix_from_quat
 from laserpick.types import Failure, Grasp, Trajectory
 

@@ -70,12 +70,12 @@ from laserpick.bench.protocols import (
 from laserpick.bench.report import markdown
 from laserpick.bench.results import RESULT_PACKAGES, environment, outcomes, summarize
 from laserpick.bench.runner import run
-from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import UNSEEN_WAYS
 from laserpick.robot.sim.objects import LIBRARY
 from laserpick.robot.sim.scenes import load_scene, scene_config
+from laserpick.robot.sim.truth import capture
 from laserpick.transforms import (
     invert,
     matrix_from_quat,

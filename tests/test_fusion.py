@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse, voxel_downsample
+from laserpick.robot.sim.truth import capture
 from laserpick.settings import PerceptionSettings
 from laserpick.types import FusedCloud
 

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.laser import detect_mark, direct_mark, find_spots, pair_spots
+from laserpick.robot.sim.truth import capture
 from laserpick.settings import get_settings
 from laserpick.types import Failure, LaserMark
 

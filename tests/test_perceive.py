@@ -6,10 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import capture, iou
+from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.scenes import parse_scene
+from laserpick.robot.sim.truth import capture
 
 
 @pytest.fixture(scope="module")

@@ -9,12 +9,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import capture
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.projector import highlight_disc, highlight_points, projector_intrinsics
 from laserpick.robot.sim.model import PROJECTOR_CAMERA
 from laserpick.robot.sim.sensors import CAM_TO_OPTICAL
+from laserpick.robot.sim.truth import capture
 from laserpick.transforms import make_transform, pinhole_intrinsics
 from laserpick.types import Projector
 

@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import Captured, capture, iou
+from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.segment import (
     NO_OBJECT,
@@ -22,6 +22,7 @@ from laserpick.pipeline.segment import (
     segment_target,
 )
 from laserpick.robot.sim.scenes import parse_scene
+from laserpick.robot.sim.truth import Captured, capture
 from laserpick.settings import PerceptionSettings
 from laserpick.types import Failure, FusedCloud, Segmentation
 

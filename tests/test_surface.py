@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from laserpick.bench.truth import capture
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.surface import (
     is_flat_surface,
@@ -14,6 +13,7 @@ from laserpick.pipeline.surface import (
     still_standing,
     surface_height,
 )
+from laserpick.robot.sim.truth import capture
 from laserpick.settings import PerceptionSettings
 from laserpick.types import Failure, FusedCloud
 

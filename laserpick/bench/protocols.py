@@ -54,7 +54,6 @@ from laserpick.bench.operator import (
     scene_config_backed,
 )
 from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
-from laserpick.bench.truth import Captured
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasping import UNSEEN_WAYS
@@ -67,6 +66,7 @@ from laserpick.robot.sim.scenes import (
     parse_scene,
     scene_config,
 )
+from laserpick.robot.sim.truth import Captured
 from laserpick.server.session import HOLDING_STATES, Selection, StrategyName, TaskState
 from laserpick.transforms import matrix_from_quat, planar_pose
 from laserpick.types import Failure

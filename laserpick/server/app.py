@@ -35,10 +35,10 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from starlette.websockets import WebSocketDisconnect
 
 from laserpick import __version__
-from laserpick.bench.operator import Referee
 from laserpick.console.view_page import view_page
 from laserpick.pipeline.cloud import voxel_downsample
 from laserpick.robot.sim.scenes import SceneError, load_scene, parse_scene
+from laserpick.robot.sim.truth import SimTruth
 from laserpick.server import schemas as S
 from laserpick.server.lease import LeaseHeld
 from laserpick.server.session import Actor, Conflict, Session
@@ -369,7 +369,7 @@ def create_app(
         """Simulator ground truth: where each object is. For scoring and scripted operators
         (benchmarks, tests) only; a real robot has no such endpoint, and the session never
         reads it."""
-        referee = Referee(session.robot)
+        referee = SimTruth(session.robot)
         out = []
         for p in session.robot.sim.scene.placements if session.robot.sim.scene else ():
             pts = referee.object_points(p.instance)
