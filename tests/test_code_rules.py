@@ -130,9 +130,11 @@ def too_long(path: Path) -> list[str]:
     return out
 
 
-#: "stop 57", "round 12", and a word of 7-40 hex digits with a letter and a digit (a commit).
+#: "stop 57", "round 12", "seed 1's soda can", "seed 200 trial 1", and a word of 7-40 hex
+#: digits with a letter and a digit (a commit).
 HISTORY = re.compile(
-    r"\b(stop|round)s? \d+\b|\b(?=[0-9a-f]*\d)(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}\b",
+    r"\b(stop|round)s? \d+\b|\bseed \d+('s| trial)|"
+    r"\b(?=[0-9a-f]*\d)(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}\b",
     re.IGNORECASE,
 )
 
@@ -293,6 +295,6 @@ def test_a_sim_read_and_a_long_function_are_caught(planted):
 
 def test_history_in_a_comment_is_caught(planted):
     path = planted(
-        "laserpick.probe", '"""Fixed in 0512a73."""\n\n# the mug slid on round 12\nX = 1\n'
+        "laserpick.probe", '"""Fixed in 0512a73."""\n\n# the mug slid on round 12\n# seed 1's can\nX = 1\n'
     )
-    assert len(history_in_comments(path)) == 2
+    assert len(history_in_comments(path)) == 3
