@@ -294,7 +294,7 @@ def test_a_sim_read_and_a_long_function_are_caught(planted):
 
 
 def test_history_in_a_comment_is_caught(planted):
-    path = planted(
-        "laserpick.probe", '"""Fixed in 0512a73."""\n\n# the mug slid on round 12\n# seed 1's can\nX = 1\n'
+    source = (
+        '"""Fixed in 0512a73."""\n\n# the mug slid on round 12\n# as seed 1\'s can did\nX = 1\n'
     )
-    assert len(history_in_comments(path)) == 3
+    assert len(history_in_comments(planted("laserpick.probe", source))) == 3
