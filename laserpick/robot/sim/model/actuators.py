@@ -41,10 +41,9 @@ def add_actuators(spec: mujoco.MjSpec) -> None:
     )
     eq.objtype = mujoco.mjtObj.mjOBJ_JOINT
     eq.data[:5] = [0, 1, 0, 0, 0]
-    # The linkage is rigid. At MuJoCo's default softness the coupling gave way under the
-    # grip force: the driven finger pushed the object 1.1 cm off the hand's centre,
-    # against the other finger opened to its stop.
-    # The stiffest MuJoCo keeps stable: a time constant of two steps.
+    # The linkage is rigid: at MuJoCo's default softness the coupling gives way under the grip
+    # force, and the driven finger pushes the object 1.1 cm off the hand's centre. This is
+    # the stiffest MuJoCo keeps stable: a time constant of two steps.
     eq.solref = [2 * spec.option.timestep, 1.0]
     eq.solimp = [0.99, 0.999, 0.001, 0.5, 2.0]
     # Base: velocity servos on the planar joints; the drive turns (v, w) into these.

@@ -18,8 +18,8 @@ from laserpick.robot.sim.objects.object_model import GEOM_TYPE, MeshAsset, Objec
 #: Torsional and rolling friction of every object geom (m), after the sliding coefficient.
 OBJECT_FRICTION_TAIL = (0.005, 0.0005)
 #: Contact dimensionality of object geoms: sliding, torsional and rolling friction. Without
-#: rolling friction (4) a can laid on its side crept into a roll and off its table within a
-#: minute. The pads' contacts take the pads' own (4): they have priority.
+#: rolling friction (4) a can laid on its side rolls off its table within a minute. The pads'
+#: contacts take the pads' own (4): they have priority.
 OBJECT_CONDIM = 6
 
 
