@@ -206,8 +206,8 @@ def _dishes_and_utensils() -> list[ObjectModel]:
     ]
 
 
-def _personal_items() -> list[ObjectModel]:
-    """Phones, a remote, hygiene items, a mouse, a marker, a wallet, keys (000 section 5.2)."""
+def _phones_and_hygiene() -> list[ObjectModel]:
+    """Phones, a remote and hygiene items (000 section 5.2)."""
     return [
         make_object(
             "cordless_phone",
@@ -233,6 +233,12 @@ def _personal_items() -> list[ObjectModel]:
         make_object(
             "tissue_packet", "hygiene", [box_part(0.053, 0.027, 0.0125)], 0.02, 0.8, _WHITE
         ),
+    ]
+
+
+def _personal_items() -> list[ObjectModel]:
+    """A mouse, a marker, a glasses case, a wallet and keys (000 section 5.2)."""
+    return [
         make_object(
             "computer_mouse",
             "electronics",
@@ -281,7 +287,15 @@ def _toys() -> list[ObjectModel]:
 
 
 #: The library's families, in the library's order.
-_FAMILIES = (_drinks, _medicine, _boxes_and_food, _dishes_and_utensils, _personal_items, _toys)
+_FAMILIES = (
+    _drinks,
+    _medicine,
+    _boxes_and_food,
+    _dishes_and_utensils,
+    _phones_and_hygiene,
+    _personal_items,
+    _toys,
+)
 
 
 def _build_library() -> dict[str, ObjectModel]:
