@@ -173,7 +173,7 @@ def test_realtime_loop_keeps_pace_and_pauses():
 
 def test_a_can_laid_on_its_side_stays_on_its_table():
     """Object contacts have rolling friction: without it, a soda can laid on its side on the
-    kitchen's 73 cm table crept into a roll and was off the table within a minute."""
+    kitchen's 73 cm table rolls off it within a minute."""
     import yaml
 
     from laserpick.robot.sim.scenes import parse_scene, scene_config
@@ -194,8 +194,8 @@ def test_a_can_laid_on_its_side_stays_on_its_table():
 
 
 def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
-    """`_contacts` gives the normal force on our geom: an object resting on its table is pushed up
-    by its weight. `_felt` adds forces as vectors within a body (a finger pressed from both
+    """`contacts` gives the normal force on our geom: an object resting on its table is pushed
+    up by its weight. `felt` adds forces as vectors within a body (a finger pressed from both
     sides at once feels nothing net) and their sizes across bodies."""
     from laserpick.robot.sim.loop import Contact
 
@@ -203,17 +203,17 @@ def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
     m = sim.model
     name, body = next(iter(sim.info.object_bodies.items()))
     ours = m.geom_bodyid == body
-    contacts = sim.call(lambda m_, d_: sim._contacts(ours, from_outside=True))
+    contacts = sim.call(lambda m_, d_: sim.contacts(ours, from_outside=True))
     assert contacts, f"{name} rests on nothing"
     weight = float(m.body_subtreemass[body]) * 9.81
     net = np.sum([c.on_ours for c in contacts], axis=0)
     np.testing.assert_allclose(net, [0.0, 0.0, weight], atol=0.05 * weight)
-    assert sim._felt(contacts) == pytest.approx(weight, rel=0.05)
+    assert sim.felt(contacts) == pytest.approx(weight, rel=0.05)
     arm = np.asarray(sim.info.arm_geoms)
     finger = int(arm[-1])  # two geoms of the arm on different bodies
     wrist = int(next(g for g in arm if m.geom_bodyid[g] != m.geom_bodyid[finger]))
     push = np.array([0.0, 40.0, 0.0])
     pinched = [Contact(40.0, finger, 0, push), Contact(40.0, finger, 0, -push)]
-    assert sim._felt(pinched) == pytest.approx(0.0)
+    assert sim.felt(pinched) == pytest.approx(0.0)
     two = [Contact(40.0, finger, 0, push), Contact(30.0, wrist, 0, np.array([30.0, 0, 0]))]
-    assert sim._felt(two) == pytest.approx(70.0)
+    assert sim.felt(two) == pytest.approx(70.0)

@@ -19,15 +19,22 @@ import queue
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import NamedTuple
 
 import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.robot.interface import PROTECTIVE_STOP, MotionHandle, MotionStatus
+from laserpick.robot.interface import MotionHandle, MotionStatus
 from laserpick.robot.sim.arm_control import CartesianController, TrajectoryTracker
+from laserpick.robot.sim.loop.contacts import (
+    Contact,
+    arm_contacts,
+    contact_stop,
+    contacts_on,
+    felt_force,
+)
+from laserpick.robot.sim.loop.drive import BaseDrive
+from laserpick.robot.sim.loop.snapshot import Snapshot, take_snapshot
 from laserpick.robot.sim.model import ModelInfo, build_arm_model, build_sim_model
 from laserpick.robot.sim.scenes import Scene
 from laserpick.settings import Settings, get_settings
@@ -37,48 +44,6 @@ log = logging.getLogger(__name__)
 
 #: Physics steps per real-time chunk: 10 steps = 20 ms at 500 Hz.
 _CHUNK_STEPS = 10
-#: What a console says when the scooter stops itself; what the arm met follows.
-DRIVE_STOP = "The scooter stopped: driving pushed the arm into something. Drive back to free it"
-#: s of driving without being stopped again before that notice is taken down: the stick held
-#: against the push stops the scooter every few steps, and the notice must not flicker.
-DRIVE_STOP_CLEARS = 0.5
-
-
-@dataclass(frozen=True)
-class Snapshot:
-    """A consistent copy of the simulation state at one instant, safe to read from any thread.
-
-    Poses are in `world`. `base_pose` is the scooter's (x, y, yaw) in `world`.
-    """
-
-    time: float
-    qpos: np.ndarray
-    qvel: np.ndarray
-    xpos: np.ndarray  #: (nbody, 3) body positions
-    xquat: np.ndarray  #: (nbody, 4) body orientations (w, x, y, z)
-    arm_q: np.ndarray  #: (6,) rad
-    arm_qd: np.ndarray  #: (6,) rad/s
-    base_pose: np.ndarray  #: (3,) x, y (m), yaw (rad)
-    base_velocity: np.ndarray  #: (2,) forward speed (m/s), turn rate (rad/s)
-    gripper_width: float  #: opening between the pads (m)
-    gripper_force: float  #: summed normal force on the pads (N)
-    gripper_closed: bool  #: the last gripper command was "close"
-    holding: bool
-    estopped: bool
-    moving: bool  #: an arm motion is in progress
-    #: Why the scooter last stopped itself while driving (it pushed the still arm into
-    #: something), until it has driven freely for DRIVE_STOP_CLEARS; "" otherwise.
-    drive_stop: str
-    rtf: float  #: measured real-time factor of the loop (sim seconds per wall second)
-
-
-class Contact(NamedTuple):
-    """A contact on one of our geoms (the arm's, or what the hand holds)."""
-
-    normal: float  #: the normal force's size (N)
-    ours: int  #: our geom
-    other: int  #: the geom it touches
-    on_ours: np.ndarray  #: (3,) the contact's normal force on our geom (N, `world`)
 
 
 class Simulation:
@@ -141,13 +106,7 @@ class Simulation:
             self._cartesian.target = None
             self._cart_tol = (0.001, math.radians(0.5))
             self._cart_deadline = 0.0
-            self._drive_cmd = np.zeros(2)
-            self._drive_deadline = -1.0
-            self._drive_now = np.zeros(2)
-            self._rest_push = 0.0  # N on the still arm when the current drive began
-            self._push_reported = -math.inf  # sim time (s) the last such push was logged
-            self._drive_stop = ""  # why the scooter last stopped itself, until it drives on
-            self._drive_stopped_at = -math.inf  # sim time (s) of that stop
+            self._drive = BaseDrive(m, d, info)
             self.estopped = False
             self._steps = 0
             mujoco.mj_forward(m, d)
@@ -253,8 +212,7 @@ class Simulation:
         def apply() -> None:
             if self.estopped:
                 return
-            self._drive_cmd = np.array([v, w])
-            self._drive_deadline = self.data.time + duration
+            self._drive.drive(v, w, duration)
 
         self._post(apply)
 
@@ -384,12 +342,12 @@ class Simulation:
                     for event in motion.due_events(d.time):
                         self._grip_closed = event.action == "close"
                         self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
-                    if self._stopped_by_contact(motion.traj.guard_force):
+                    if self._stop_on_contact(motion.traj.guard_force):
                         return
                     if motion.finished(d.time):
                         self._end_motion("done")
                 else:
-                    if self._stopped_by_contact(None):
+                    if self._stop_on_contact(None):
                         return
                     q = d.qpos[info.arm_qpos].copy()
                     self._q_set = motion.step(self._q_set, dt)
@@ -408,20 +366,7 @@ class Simulation:
         step = dims.GRIPPER_SPEED / 2 * dt
         self._grip_set += float(np.clip(self._grip_target - self._grip_set, -step, step))
         d.ctrl[info.gripper_ctrl] = self._grip_set
-        self._drive_tick(dt)
-
-    def _drive_tick(self, dt: float) -> None:
-        d, info = self.data, self.info
-        want = self._drive_cmd if d.time < self._drive_deadline else np.zeros(2)
-        if self._motion is None and self._drive_pushes_arm(want):
-            return
-        if self._drive_stop and want.any() and d.time - self._drive_stopped_at > DRIVE_STOP_CLEARS:
-            self._drive_stop = ""
-        limits = np.array([dims.BASE_A_MAX, dims.BASE_ALPHA_MAX]) * dt
-        self._drive_now = self._drive_now + np.clip(want - self._drive_now, -limits, limits)
-        v, w = self._drive_now
-        yaw = d.qpos[info.base_qpos[2]]
-        d.ctrl[info.base_ctrl] = [v * math.cos(yaw), v * math.sin(yaw), w]
+        self._drive.tick(dt, self._motion is None, self.arm_contacts)
 
     def _replace_motion(
         self, motion: TrajectoryTracker | CartesianController, handle: MotionHandle
@@ -431,51 +376,19 @@ class Simulation:
         self._motion, self._handle = motion, handle
         self._q_set = self.data.qpos[self.info.arm_qpos].copy()
 
-    def _drive_pushes_arm(self, want: np.ndarray) -> bool:
-        """Whether the scooter, driving (`want`: the command, m/s and rad/s), pushes the
-        still arm or what it holds into something harder than the protective stop's limit,
-        or than the push when the base last stood still, if that was more (an arm resting on
-        a counter may be driven off it). Then the base stops at once, and the arm keeps its
-        setpoint, so a stick held against the push does not bend it back step by step. The
-        UR5 feels such a push as it feels a motion pushed back (`_stopped_by_contact`), and
-        our system stops the scooter with it: without this, a juice bottle in the hand, the
-        gripper and link 2 were pressed into the 108 cm table at 500 to 1,400 N for seconds
-        while the scooter turned away from it."""
-        starting = not self._drive_now.any()
-        if starting and not want.any():  # standing still: nothing to watch each step
-            return False
-        contacts = self._arm_contacts()
-        pushed = self._felt(contacts)
-        if starting:  # the push the drive starts from, the base still standing
-            self._rest_push = pushed
-        if pushed <= max(dims.UR5_PROTECTIVE_STOP_FORCE, self._rest_push):
-            return False
-        self._drive_stop = f"{DRIVE_STOP} ({self._contact_report(contacts, pushed)})."
-        if self.data.time - self._push_reported > 1.0:  # once a second, not every step
-            log.warning(self._drive_stop)
-            self._push_reported = self.data.time
-        self._drive_stopped_at = self.data.time
-        self._stop_base()
-        return True
-
     def _end_motion(self, status: MotionStatus, message: str = "") -> None:
         if self._handle is not None:
             self._handle.finish(status, message)
         self._motion, self._handle = None, None
 
-    def _stopped_by_contact(self, guard_force: float | None) -> bool:
-        """Stop the motion where the force from outside on the arm passes its guard (N), or
-        on any motion the protective stop's limit: the UR5 controller stops every motion it
-        feels pushed back that hard, planned around what it was shown or not."""
-        contacts = self._arm_contacts()
-        total = self._felt(contacts)
-        if guard_force is not None and total > guard_force:
-            self._halt("failed", f"unexpected contact: {self._contact_report(contacts, total)}")
-            return True
-        if total > dims.UR5_PROTECTIVE_STOP_FORCE:
-            self._halt("failed", PROTECTIVE_STOP + self._contact_report(contacts, total))
-            return True
-        return False
+    def _stop_on_contact(self, guard_force: float | None) -> bool:
+        """Halt the motion, failed, where the contacts on the arm trip its guard (N) or the
+        protective stop (`contacts.contact_stop`); whether it did."""
+        reason = contact_stop(self.model, self.arm_contacts(), guard_force)
+        if reason is None:
+            return False
+        self._halt("failed", reason)
+        return True
 
     def _halt(self, status: MotionStatus, message: str) -> None:
         """Hold the arm where it is and stop the base, at once."""
@@ -485,16 +398,7 @@ class Simulation:
         d.ctrl[info.arm_ctrl] = self._q_set
         # The UR5's brakes and the scooter's motor brake: motion stops this step.
         d.qvel[info.arm_dof] = 0.0
-        self._stop_base()
-
-    def _stop_base(self) -> None:
-        """Stop the scooter this step, and drop the drive command."""
-        d, info = self.data, self.info
-        d.qvel[info.base_dof] = 0.0
-        self._drive_cmd[:] = 0.0
-        self._drive_now[:] = 0.0
-        self._drive_deadline = -1.0
-        d.ctrl[info.base_ctrl] = 0.0
+        self._drive.stop()
 
     def _refuse_when_stopped(self, handle: MotionHandle) -> bool:
         if self.estopped:
@@ -502,101 +406,42 @@ class Simulation:
             return True
         return False
 
-    def _contacts(self, geoms: np.ndarray, *, from_outside: bool = False) -> list[Contact]:
-        """Each contact touching any of `geoms` (a mask over the model's geoms), with its
-        normal force on our geom; from_outside: only those between one of `geoms` and one not
-        among them."""
-        d = self.data
-        if d.ncon == 0:
-            return []
-        # Every motion checks this every control tick: find the few contacts that touch
-        # `geoms` in one vectorized pass, and ask MuJoCo for the force of those only.
-        pairs = d.contact.geom  # (ncon, 2)
-        a, b = geoms[pairs[:, 0]], geoms[pairs[:, 1]]
-        out = []
-        force = np.zeros(6)
-        for i in np.flatnonzero((a != b) if from_outside else (a | b)):
-            mujoco.mj_contactForce(self.model, d, int(i), force)
-            # The contact frame's first row is the normal from geom1 to geom2: the normal
-            # force pushes geom2 along it, and geom1 the other way.
-            on_second = d.contact.frame[i, :3] * force[0]
-            (ours, other), on_ours = (pairs[i], -on_second) if a[i] else (pairs[i, ::-1], on_second)
-            out.append(Contact(abs(float(force[0])), int(ours), int(other), on_ours))
-        return out
+    # --- contacts (sim thread, or through `call`) ---------------------------------------------
+
+    def contacts(self, geoms: np.ndarray, *, from_outside: bool = False) -> list[Contact]:
+        """The contacts now on `geoms` (a mask over the model's geoms), as
+        `contacts.contacts_on` gives them."""
+        return contacts_on(self.model, self.data, geoms, from_outside=from_outside)
+
+    def arm_contacts(self) -> list[Contact]:
+        """The contacts from outside on the arm, the gripper and what a closed gripper holds
+        (`contacts.arm_contacts`)."""
+        return arm_contacts(
+            self.model, self.data, self._arm_geoms, self._pad_geoms, self._grip_closed
+        )
+
+    def felt(self, contacts: list[Contact]) -> float:
+        """What the UR5's force estimate reads of `contacts` (N; `contacts.felt_force`)."""
+        return felt_force(self.model, contacts)
+
+    # The same, by the private names tests/test_behaviours.py calls.
+    _contacts = contacts
+    _arm_contacts = arm_contacts
+    _felt = felt
 
     def _gripper_force(self) -> float:
         """Force (N) on the pads: what the gripper's own current sensing reports."""
-        return sum(c.normal for c in self._contacts(self._pad_geoms))
-
-    def _arm_contacts(self) -> list[Contact]:
-        """The contacts from outside on the arm and the gripper, and on what a closed gripper
-        holds, as `_contacts` gives them (`_felt` says what they add up to). The grip itself
-        (the pads on the held object) is internal and not counted: counted, it tripped every
-        guarded place at once, and the object was let go from 10 cm up."""
-        if not self._grip_closed or self.data.ncon == 0:
-            return self._contacts(self._arm_geoms)
-        m, pairs = self.model, self.data.contact.geom
-        on_pad = self._pad_geoms[pairs]
-        touched = np.where(on_pad[:, 0], pairs[:, 1], pairs[:, 0])[on_pad.any(axis=1)]
-        if len(touched) == 0:
-            return self._contacts(self._arm_geoms)
-        # The held object: every geom of the bodies the pads touch.
-        held = np.isin(m.geom_bodyid, m.geom_bodyid[touched])
-        return self._contacts(self._arm_geoms | held, from_outside=True)
-
-    def _felt(self, contacts: list[Contact]) -> float:
-        """What the UR5's joint-current force estimate, or a wrist force sensor, reads of
-        `contacts` (N): the normal forces on each body of the arm (and on what the hand
-        holds) added as vectors, and the bodies' net forces' sizes added up. Sizes added
-        contact by contact read 21 kN where an opened finger had gone through a mug's handle
-        and the solver pressed it from both sides at once: forces that cancel in the finger,
-        and that no sensor would feel. Friction is left out, as when the guards' limits (25
-        N on an approach, 150 N anywhere) were set: with it, a finger brushing a mug's handle
-        on the way in read 25-28 N, and the guard stopped approaches it had let through."""
-        if not contacts:
-            return 0.0
-        body = self.model.geom_bodyid[[c.ours for c in contacts]]
-        net = np.zeros((self.model.nbody, 3))
-        np.add.at(net, body, np.array([c.on_ours for c in contacts]))
-        return float(np.linalg.norm(net[np.unique(body)], axis=1).sum())
-
-    def _contact_report(self, contacts: list[Contact], felt: float) -> str:
-        """'{N} N on the arm, most where {body} met {body}': what a guarded stop says, with
-        `felt` (N) the `_felt` force that stopped it."""
-        worst = max(contacts, key=lambda c: c.normal)
-        body = self.model.geom_bodyid
-        ours_name, other_name = (
-            self.model.body(int(body[g])).name or "the world" for g in (worst.ours, worst.other)
-        )
-        return f"{felt:.0f} N on the arm, most where {ours_name} met {other_name}"
+        return sum(c.normal for c in self.contacts(self._pad_geoms))
 
     def _publish(self) -> None:
-        d, info = self.data, self.info
-        width = float(d.qpos[info.finger_qpos].sum())  # each finger's travel from centre
-        force = self._gripper_force()
-        yaw = float(d.qpos[info.base_qpos[2]])
-        vx, vy = d.qvel[info.base_dof[:2]]
-        snap = Snapshot(
-            time=float(d.time),
-            qpos=d.qpos.copy(),
-            qvel=d.qvel.copy(),
-            xpos=d.xpos.copy(),
-            xquat=d.xquat.copy(),
-            arm_q=d.qpos[info.arm_qpos].copy(),
-            arm_qd=d.qvel[info.arm_dof].copy(),
-            base_pose=d.qpos[info.base_qpos].copy(),
-            base_velocity=np.array(
-                [vx * math.cos(yaw) + vy * math.sin(yaw), d.qvel[info.base_dof[2]]]
-            ),
-            gripper_width=width,
-            gripper_force=force,
+        snap = take_snapshot(
+            self.data,
+            self.info,
+            gripper_force=self._gripper_force(),
             gripper_closed=self._grip_closed,
-            holding=self._grip_closed
-            and width > dims.GRIPPER_EMPTY_GAP
-            and force > dims.GRIPPER_HOLD_FORCE,
             estopped=self.estopped,
             moving=self._handle is not None,
-            drive_stop=self._drive_stop,
+            drive_stop=self._drive.stop_reason,
             rtf=self._rtf,
         )
         self._snap = snap
