@@ -116,6 +116,10 @@ class Client:
     def state(self) -> dict[str, Any]:
         return self.get("/state")
 
+    def health(self) -> dict[str, Any]:
+        """`GET /health`: the server's version, scene, 3D view address and limits."""
+        return self.get("/health")
+
     # --- the lease and the heartbeat -----------------------------------------------------
 
     def take_control(self) -> str:
