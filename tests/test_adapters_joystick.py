@@ -170,6 +170,3 @@ def test_sip_and_puff_held_over_a_reconnection_does_nothing() -> None:
     sp.on_input(InputEvent(6.0, "release", "hard_puff"))
     sp.advance(8.0)
     assert link.total()[1] == pytest.approx(moved)  # nothing after the loss, nor a tap
-
-
-# --- the connection, on a fake client ---------------------------------------------------------

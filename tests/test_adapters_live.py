@@ -208,8 +208,8 @@ def test_server_killed_mid_drive_reconnect_sends_no_unasked_motion(tmp_path: Pat
     (tmp_path / "a").mkdir()
     first = ServeProcess(tmp_path / "a").start()
     s = Script()
-    # The timeline starts once the adapter is connected: on a loaded machine it connected
-    # 1.1 s after it started, after a press at 0.5 s, which it then (rightly) did not obey.
+    # The timeline starts once the adapter is connected: input before that is (rightly) not
+    # obeyed, and on a loaded machine connecting takes over a second.
     s.wait("state=idle", timeout=60)
     s.at(0.5, "press drive")
     s.at(0.6, "axis y 0.8")  # held over the outage: the replay pauses while it lasts

@@ -21,6 +21,7 @@ from laserpick.adapters import (
 
 
 def kinds(outputs: list) -> list[str]:
+    """Output type names, with the key for a highlight (`Highlight:laser`)."""
     return [type(o).__name__ + (f":{o.key}" if isinstance(o, Highlight) else "") for o in outputs]
 
 

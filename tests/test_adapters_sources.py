@@ -105,9 +105,6 @@ def test_script_source_times_from_waits_and_pauses_while_disconnected() -> None:
     assert src.finished
 
 
-# --- the joystick presets on a fake link -------------------------------------------------------
-
-
 # --- sources and announcements -------------------------------------------------------------------
 
 
