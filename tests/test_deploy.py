@@ -41,10 +41,8 @@ import pytest
 from serve_process import ServeProcess, free_port, stop_process
 
 # The asyncio client, not websockets.sync: the sync client reads its TLS socket on a thread of
-# its own while the caller writes the handshake, and OpenSSL does not allow one session to be
-# used from two threads at once. Under load about 1 handshake in 75 was lost that way (nginx
-# logged "client closed connection while waiting for request"); the asyncio client drives the
-# session from one thread (its event loop) and lost none of 400 under the same load.
+# its own while the caller writes, and one OpenSSL session must not be used from two threads
+# (under load about 1 handshake in 75 was lost that way; with the asyncio client, none of 400).
 from websockets.asyncio.client import connect as wss_connect
 
 REPO = Path(__file__).resolve().parents[1]

@@ -3,6 +3,9 @@
 One thread owns the `laserpick.client.Client` and sends everything, in the order the input
 asked for it, so the input loop never waits on the network. It:
 
+- reads the server's limits from `GET /health` at each connection (`max_nudge`, the largest
+  laser nudge it takes per command, rad) and stops with a clear message when the server does
+  not send them;
 - takes the control lease (the Client heartbeats on the events websocket every 0.15 s), and
   says clearly when someone else holds it;
 - notices a lost server (a request fails, or the 30 Hz state frames stop and `/health` does
@@ -37,9 +40,6 @@ from websockets.exceptions import WebSocketException
 from laserpick.adapters.announce import Announcer
 from laserpick.client import ApiError, Client, describe
 
-#: Largest laser nudge the server takes per command (rad): `ServerSettings.max_nudge`.
-MAX_NUDGE = 0.2
-
 Run = Callable[[Client], "str | None"]
 
 
@@ -55,6 +55,24 @@ class _Command:
 
 class _Lost(Exception):
     """The server is gone (or no longer knows our lease)."""
+
+
+class MissingLimit(Exception):
+    """The server's `GET /health` does not state a limit this adapter needs."""
+
+
+def nudge_limit(health: dict[str, Any]) -> float:
+    """The largest laser nudge (rad) the server takes per command, from its `GET /health`
+    answer. Raises MissingLimit when the answer has no positive, finite `max_nudge`."""
+    value = health.get("max_nudge")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise MissingLimit(
+            "the server's GET /health has no max_nudge (its largest laser nudge, rad): "
+            "it is older than this adapter; update the server"
+        )
+    if not (math.isfinite(value) and value > 0):
+        raise MissingLimit(f"the server's max_nudge is {value!r}, not a positive number of rad")
+    return float(value)
 
 
 def reason(exc: BaseException) -> str:
@@ -128,6 +146,7 @@ class Connection:
         self._frames, self._frame_at, self._probed_at = 0, 0.0, -math.inf
         self._thread: threading.Thread | None = None
         self.fatal: str | None = None  #: set when retrying cannot help (a wrong password)
+        self.max_nudge: float | None = None  #: rad per nudge command, from GET /health
         self.drives_sent = 0  #: POST /drive commands with motion, all links together
         self.connections = 0  #: successful connections so far
 
@@ -314,7 +333,9 @@ class Connection:
             self.say.note(refusal(cmd.label, exc))
 
     def _send_nudge(self, client: Client, dyaw: float, dpitch: float) -> None:
-        steps = max(1, math.ceil(max(abs(dyaw), abs(dpitch)) / MAX_NUDGE - 1e-9))
+        """Send a turn as equal nudges, each within the server's `max_nudge`."""
+        assert self.max_nudge is not None  # read at connect
+        steps = max(1, math.ceil(max(abs(dyaw), abs(dpitch)) / self.max_nudge - 1e-9))
         for _ in range(steps):
             body = {"dyaw": dyaw / steps, "dpitch": dpitch / steps}
             self._request("laser nudge", lambda b=body: client.post("/laser/nudge", b))
@@ -375,20 +396,20 @@ class Connection:
         )
         client.token = self._old_token  # renews our lease if the server still has it
         try:
+            max_nudge = nudge_limit(client.health())
             client.take_control()
+        except MissingLimit as exc:
+            client.release()
+            return self._give_up(str(exc))
         except ApiError as exc:
             client.release()
             if exc.status == 401:
-                self.fatal = f"the server refused the password: {describe(exc.detail)}"
-                self.say.note(self.fatal)
-                with self._cond:
-                    self._closing = True
-                self._notify()
-                return self.fatal, 0.0
+                return self._give_up(f"the server refused the password: {describe(exc.detail)}")
             return f"cannot take control: {describe(exc.detail)}", self.backoff_max
         except (requests.RequestException, OSError, WebSocketException) as exc:
             client.release()
             return f"cannot reach {self.url}: {reason(exc)}", 0.0
+        self.max_nudge = max_nudge
         self._client = client
         self._old_token = client.token
         self._frames, self._frame_at, self._probed_at = client.frames, self.clock(), -math.inf
@@ -401,6 +422,15 @@ class Connection:
         self.say.note(f"connected to {self.url} as {self.name!r}: control taken")
         self._notify()
         return None
+
+    def _give_up(self, why: str) -> tuple[str, float]:
+        """Retrying cannot help: say why, and close the link (the runner exits with 2)."""
+        self.fatal = why
+        self.say.note(why)
+        with self._cond:
+            self._closing = True
+        self._notify()
+        return why, 0.0
 
     def _lose(self, why: str) -> None:
         with self._cond:

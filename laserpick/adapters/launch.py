@@ -30,11 +30,13 @@ from types import FrameType
 from laserpick.adapters.announce import Announcer
 from laserpick.adapters.connection import Connection
 from laserpick.adapters.devices import Binding, EvdevSource, KeyboardSource, parse_maps
-from laserpick.adapters.joystick import JoystickOptions, SipPuffAdapter, StickAdapter
+from laserpick.adapters.joystick import JoystickOptions
 from laserpick.adapters.runner import Controller, Runner, open_record
-from laserpick.adapters.scanning import ScanTiming
+from laserpick.adapters.sip_puff import SipPuffAdapter
 from laserpick.adapters.sources import Source, SourceError, load_script
+from laserpick.adapters.stick import StickAdapter
 from laserpick.adapters.switch import SwitchAdapter, SwitchOptions
+from laserpick.adapters.switch_timing import ScanTiming
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
@@ -116,35 +118,40 @@ def make_source(
     raise SourceError(f"--source {spec!r}: use evdev:NAME_OR_PATH, keyboard or script:FILE")
 
 
+def make_controller(
+    args: argparse.Namespace, link: Connection, say: Announcer
+) -> tuple[Controller, dict[str, Binding], dict[str, Binding], float]:
+    """The adapter's controller for the parsed arguments, with its keyboard and evdev
+    bindings and the keyboard's tap length (s). Raises ValueError for bad options."""
+    options: SwitchOptions | JoystickOptions
+    if args.adapter == "switch":
+        timing = ScanTiming(args.scan_period, args.cycles, args.accept, args.release, args.delay)
+        options = SwitchOptions(args.mode, timing, args.step, args.speed, args.turn)
+    else:
+        options = JoystickOptions(
+            preset=args.preset,
+            dead_zone=args.dead_zone,
+            rate=args.rate,
+            speed=args.speed,
+            turn=args.turn,
+            step=args.step,
+            hold=args.hold,
+            double=args.double,
+        )
+    for name in ("step", "speed", "turn"):
+        if not getattr(args, name) > 0:
+            raise ValueError(f"--{name} must be more than 0")
+    if isinstance(options, SwitchOptions):
+        tap_s = max(0.15, args.accept + 0.05)
+        return SwitchAdapter(options, link, say), SWITCH_KEYS, SWITCH_EVDEV, tap_s
+    if options.preset == "stick":
+        return StickAdapter(options, link, say), STICK_KEYS, STICK_EVDEV, 0.1
+    return SipPuffAdapter(options, link, say), SIP_KEYS, SIP_EVDEV, 0.1
+
+
 def run(args: argparse.Namespace) -> int:
     """Run `laserpick adapter <args.adapter>` until its input ends; the exit code."""
     say = Announcer(speak=args.speak)
-    try:
-        if args.adapter == "switch":
-            timing = ScanTiming(
-                args.scan_period, args.cycles, args.accept, args.release, args.delay
-            )
-            sw = SwitchOptions(args.mode, timing, args.step, args.speed, args.turn)
-            keys, evdev, tap_s = SWITCH_KEYS, SWITCH_EVDEV, max(0.15, args.accept + 0.05)
-        else:
-            js = JoystickOptions(
-                preset=args.preset,
-                dead_zone=args.dead_zone,
-                rate=args.rate,
-                speed=args.speed,
-                turn=args.turn,
-                step=args.step,
-                hold=args.hold,
-                double=args.double,
-            )
-            stick = js.preset == "stick"
-            keys, evdev = (STICK_KEYS, STICK_EVDEV) if stick else (SIP_KEYS, SIP_EVDEV)
-            tap_s = 0.1
-        for name in ("step", "speed", "turn"):
-            if not getattr(args, name) > 0:
-                raise ValueError(f"--{name} must be more than 0")
-    except ValueError as exc:
-        return _fail(str(exc))
     link = Connection(
         args.url,
         name=args.name or f"{args.adapter} adapter",
@@ -152,18 +159,12 @@ def run(args: argparse.Namespace) -> int:
         announcer=say,
         password=os.environ.get(PASSWORD_ENV),
     )
-    controller: Controller
-    if args.adapter == "switch":
-        controller = SwitchAdapter(sw, link, say)
-    elif js.preset == "stick":
-        controller = StickAdapter(js, link, say)
-    else:
-        controller = SipPuffAdapter(js, link, say)
     try:
+        controller, keys, evdev, tap_s = make_controller(args, link, say)
         source = make_source(
             args.source, controller, keys=keys, evdev=evdev, maps=args.map, tap_s=tap_s
         )
-    except SourceError as exc:
+    except (ValueError, SourceError) as exc:
         return _fail(str(exc))
 
     def on_term(_signum: int, _frame: FrameType | None) -> None:

@@ -82,7 +82,7 @@ class Runner:
 
     def run(self) -> int:
         """The exit code: 0 when the input ended, 1 when a scripted wait failed, 2 when the
-        link cannot work (a refused password)."""
+        link cannot work (a refused password, a server that does not state its limits)."""
         t0 = self._t0 = self.clock()
         self.controller.start(t0)
         self.link.start(self.wake)

@@ -1,17 +1,6 @@
-"""Switch timing and scanning, as pure state machines: every method takes the time (s, on the
-adapter's monotonic clock) and returns what happened, so a test can drive them with a fake
-clock.
-
-Switch timing (`SwitchFilter`), per switch:
-- acceptance time: a press counts once it has been held `accept` s (shorter presses, a tremor
-  or a bounce, do nothing);
-- release time: presses that start within `release` s of the last release are ignored (a
-  contact bouncing as it opens, a second unintended hit).
-
-What is scanned, groups first then items (`GROUPS`): laser (up, down, left, right, confirm,
-back), grasps (previous, next, go, back), drive (forward, reverse, left, right, back), mode
-(pick and drop, pick and place, automatic grasp, manual grasp, back), and cancel, which acts
-at once. Drive items act while the switch stays held after the selection (a dead-man).
+"""The scanning state machines, pure: every method takes the time (s, on the adapter's
+monotonic clock) and returns what happened (`Output`), so a test can drive them with a fake
+clock. What is scanned is `scan_menu.GROUPS`; when a press counts is `switch_timing`.
 
 One-switch automatic scanning (`AutoScanner`): the first activation starts the scan at the
 first group; the highlight moves every `period` s; an activation enters the highlighted group
@@ -31,77 +20,22 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
-# --- what is scanned ---------------------------------------------------------------------------
+from laserpick.adapters.scan_menu import BACK, GROUPS, Group, Item
+from laserpick.adapters.switch_timing import ScanTiming, SwitchFilter
 
-
-@dataclass(frozen=True)
-class Item:
-    """One scanned choice. key: `group.item`, unique; label: what is announced; action: what
-    the adapter does; hold: acts while the switch is held (driving), not once."""
-
-    key: str
-    label: str
-    action: str
-    hold: bool = False
-
-
-@dataclass(frozen=True)
-class Group:
-    """A group of items, or (no items) a choice that acts itself, like cancel."""
-
-    key: str
-    label: str
-    items: tuple[Item, ...] = ()
-    action: str | None = None
-
-    def as_item(self) -> Item:
-        assert self.action is not None
-        return Item(self.key, self.label, self.action)
-
-
-BACK = "back"
-
-
-def _group(key: str, label: str, *items: tuple[str, str, str, bool]) -> Group:
-    made = tuple(Item(f"{key}.{k}", lab, action, hold) for k, lab, action, hold in items)
-    return Group(key, label, (*made, Item(f"{key}.back", "back", BACK)))
-
-
-GROUPS: tuple[Group, ...] = (
-    _group(
-        "laser",
-        "laser",
-        ("up", "up", "nudge_up", False),
-        ("down", "down", "nudge_down", False),
-        ("left", "left", "nudge_left", False),
-        ("right", "right", "nudge_right", False),
-        ("confirm", "confirm", "confirm", False),
-    ),
-    _group(
-        "grasps",
-        "grasps",
-        ("previous", "previous grasp", "grasp_prev", False),
-        ("next", "next grasp", "grasp_next", False),
-        ("go", "go", "go", False),
-    ),
-    _group(
-        "drive",
-        "drive",
-        ("forward", "forward", "drive_forward", True),
-        ("reverse", "reverse", "drive_reverse", True),
-        ("left", "turn left", "drive_left", True),
-        ("right", "turn right", "drive_right", True),
-    ),
-    _group(
-        "mode",
-        "mode",
-        ("drop", "pick and drop", "mode_drop", False),
-        ("place", "pick and place", "mode_place", False),
-        ("auto", "automatic grasp", "select_auto", False),
-        ("manual", "manual grasp", "select_manual", False),
-    ),
-    Group("cancel", "cancel", action="cancel"),
-)
+__all__ = [
+    "AutoScanner",
+    "Highlight",
+    "HoldEnd",
+    "HoldStart",
+    "Output",
+    "Pending",
+    "Scanner",
+    "Selected",
+    "StepScanner",
+    "Stopped",
+    "Undone",
+]
 
 
 # --- what the scanners report ------------------------------------------------------------------
@@ -109,6 +43,8 @@ GROUPS: tuple[Group, ...] = (
 
 @dataclass(frozen=True)
 class Highlight:
+    """The highlight moved onto `key`, a group or an item, at t."""
+
     t: float
     key: str
     label: str
@@ -134,6 +70,8 @@ class Pending:
 
 @dataclass(frozen=True)
 class Undone:
+    """A pending selection was undone before it acted."""
+
     t: float
     item: Item
 
@@ -148,6 +86,8 @@ class HoldStart:
 
 @dataclass(frozen=True)
 class HoldEnd:
+    """The switch held for a hold item was released (or the link dropped): stop."""
+
     t: float
     item: Item
 
@@ -160,70 +100,6 @@ class Stopped:
 
 
 Output = Highlight | Selected | Pending | Undone | HoldStart | HoldEnd | Stopped
-
-
-@dataclass(frozen=True)
-class ScanTiming:
-    """period: s per highlighted element (automatic scanning); cycles: passes without an
-    activation before falling back (0: never); accept: s a press must be held; release: s
-    after a release during which presses are ignored; delay: s between selecting and acting,
-    during which an activation undoes the selection."""
-
-    period: float = 1.0
-    cycles: int = 3
-    accept: float = 0.1
-    release: float = 0.1
-    delay: float = 0.0
-
-    def __post_init__(self) -> None:
-        for name in ("period", "accept", "release", "delay"):
-            value = getattr(self, name)
-            if not math.isfinite(value) or value < 0:
-                raise ValueError(f"{name} must be a finite number of seconds >= 0, not {value}")
-        if self.period <= 0:
-            raise ValueError("the scan period must be more than 0 s")
-        if self.cycles < 0:
-            raise ValueError("cycles must be 0 (never stop) or more")
-
-
-# --- one switch's timing -----------------------------------------------------------------------
-
-
-@dataclass
-class SwitchFilter:
-    """Raw presses and releases of one switch -> activations (see the module docstring)."""
-
-    accept: float
-    release: float
-    down_at: float | None = None
-    active: bool = False  #: the current press has been accepted
-    ignored: bool = False  #: the current press started within the release time
-    last_release: float = -math.inf
-
-    def press(self, t: float) -> None:
-        if self.down_at is not None:
-            return  # already down (a repeated report)
-        self.down_at, self.active = t, False
-        self.ignored = t - self.last_release < self.release
-
-    def up(self, t: float) -> bool:
-        """The switch opened at t; True if an accepted press ended."""
-        if self.down_at is None:
-            return False
-        was_active = self.active
-        self.down_at, self.active, self.ignored = None, False, False
-        self.last_release = t
-        return was_active
-
-    def due(self) -> float | None:
-        """When the current press will be accepted, if it is still held then."""
-        if self.down_at is None or self.active or self.ignored:
-            return None
-        return self.down_at + self.accept
-
-    def accept_at(self, t: float) -> None:
-        self.active = True
-
 
 # --- the scanners ------------------------------------------------------------------------------
 

@@ -213,37 +213,10 @@ def parse_script(
         err = functools.partial(_line_error, where, lineno)
         if len(parts) < 2:
             raise err("expected 'TIME EVENT ...'")
-        stamp, kind, args = parts[0], parts[1], parts[2:]
-        try:
-            t = (prev + float(stamp[1:])) if stamp.startswith("+") else float(stamp)
-        except ValueError:
-            raise err(f"{stamp!r} is not a time in seconds") from None
-        if not math.isfinite(t) or t < 0:
-            raise err(f"time {stamp!r} must be a finite number of seconds, >= 0")
-        if t < prev:
-            raise err(f"time {t:g} s goes back before the previous line ({prev:g} s)")
+        t = _line_time(parts[0], prev, err)
         prev = t
-        if kind in ("press", "release", "tap"):
-            if not args or args[0] not in buttons:
-                known = ", ".join(sorted(buttons))
-                raise err(f"{kind} needs a control name, one of: {known}")
-            if kind == "tap":
-                hold = _seconds(args[1], err) if len(args) > 1 else DEFAULT_TAP
-                segment.append((lineno, InputEvent(t, "press", args[0])))
-                segment.append((lineno, InputEvent(t + hold, "release", args[0])))
-            else:
-                segment.append((lineno, InputEvent(t, kind, args[0])))
-        elif kind == "axis":
-            if len(args) != 2 or args[0] not in axes:
-                raise err(f"axis needs a name ({', '.join(sorted(axes))}) and a value")
-            try:
-                value = float(args[1])
-            except ValueError:
-                raise err(f"{args[1]!r} is not a number") from None
-            if not -1.0 <= value <= 1.0:
-                raise err(f"axis value {value:g} is outside [-1, 1]")
-            segment.append((lineno, InputEvent(t, "axis", args[0], value)))
-        elif kind == "wait":
+        kind, args = parts[1], parts[2:]
+        if kind == "wait":
             wait = _parse_wait(t, args, err)
             late = [n for n, ev in segment if ev.t > t + TIME_TOLERANCE]
             if late:
@@ -253,12 +226,55 @@ def parse_script(
             segment.append((lineno, wait))
             close_segment()
             prev = 0.0
-        elif kind == "quit":
-            segment.append((lineno, Quit(t)))
         else:
-            raise err(f"unknown event {kind!r} (press, release, tap, axis, wait, quit)")
+            segment += [(lineno, ev) for ev in _line_events(t, kind, args, buttons, axes, err)]
     close_segment()
     return out
+
+
+def _line_time(stamp: str, prev: float, err: Callable[[str], ScriptError]) -> float:
+    """A line's TIME (s from the segment's origin; "+T": T s after the previous line)."""
+    try:
+        t = (prev + float(stamp[1:])) if stamp.startswith("+") else float(stamp)
+    except ValueError:
+        raise err(f"{stamp!r} is not a time in seconds") from None
+    if not math.isfinite(t) or t < 0:
+        raise err(f"time {stamp!r} must be a finite number of seconds, >= 0")
+    if t < prev:
+        raise err(f"time {t:g} s goes back before the previous line ({prev:g} s)")
+    return t
+
+
+def _line_events(
+    t: float,
+    kind: str,
+    args: list[str],
+    buttons: Collection[str],
+    axes: Collection[str],
+    err: Callable[[str], ScriptError],
+) -> list[Event]:
+    """The events of one line other than `wait`: press, release, tap, axis or quit."""
+    if kind in ("press", "release", "tap"):
+        if not args or args[0] not in buttons:
+            known = ", ".join(sorted(buttons))
+            raise err(f"{kind} needs a control name, one of: {known}")
+        if kind == "tap":
+            hold = _seconds(args[1], err) if len(args) > 1 else DEFAULT_TAP
+            return [InputEvent(t, "press", args[0]), InputEvent(t + hold, "release", args[0])]
+        return [InputEvent(t, "press" if kind == "press" else "release", args[0])]
+    if kind == "axis":
+        if len(args) != 2 or args[0] not in axes:
+            raise err(f"axis needs a name ({', '.join(sorted(axes))}) and a value")
+        try:
+            value = float(args[1])
+        except ValueError:
+            raise err(f"{args[1]!r} is not a number") from None
+        if not -1.0 <= value <= 1.0:
+            raise err(f"axis value {value:g} is outside [-1, 1]")
+        return [InputEvent(t, "axis", args[0], value)]
+    if kind == "quit":
+        return [Quit(t)]
+    raise err(f"unknown event {kind!r} (press, release, tap, axis, wait, quit)")
 
 
 def _line_error(where: str, lineno: int, msg: str) -> ScriptError:

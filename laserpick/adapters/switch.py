@@ -1,4 +1,5 @@
-"""`laserpick adapter switch`: one or two switches, by scanning (see `scanning.py`).
+"""`laserpick adapter switch`: one or two switches, by scanning (`scanning.py`, over the
+items of `scan_menu.py`, with the switch timing of `switch_timing.py`).
 
 Inputs: "switch" (the one switch; in two-switch mode, the one that moves the highlight) and
 "select" (two-switch mode: selects; in one-switch mode it is the same switch). What the
@@ -24,22 +25,23 @@ from typing import Literal
 from laserpick.adapters.announce import Announcer
 from laserpick.adapters.commands import MODE_BODIES, step_grasp
 from laserpick.adapters.connection import Connection
+from laserpick.adapters.scan_menu import GROUPS, Item
 from laserpick.adapters.scanning import (
-    GROUPS,
     AutoScanner,
     Highlight,
     HoldEnd,
     HoldStart,
-    Item,
     Output,
     Pending,
-    ScanTiming,
     Selected,
     StepScanner,
     Stopped,
     Undone,
 )
 from laserpick.adapters.sources import InputEvent
+from laserpick.adapters.switch_timing import ScanTiming
+
+__all__ = ["SwitchAdapter", "SwitchOptions"]
 
 BUTTONS = frozenset({"switch", "select"})
 #: While a drive item is held, the drive command is renewed this often (s).
