@@ -25,7 +25,7 @@ from laserpick.types import DepthFrame, Projector, Trajectory
 __all__ = ["CANNOT_MOVE", "RecordedRobot", "fallback_projector"]
 
 #: What a motion commanded of a recording reports.
-CANNOT_MOVE = "This robot plays a recording: it cannot move."
+CANNOT_MOVE = "this robot plays a recording and cannot move"
 
 
 def fallback_projector() -> Projector:

@@ -23,7 +23,10 @@ NAME = re.compile(r"^[A-Za-z0-9_\-][A-Za-z0-9_.\-]{0,63}$")
 #: How far a pose's rotation may be from orthonormal (JSON keeps floats exactly; a driver
 #: writing rounded calibration stays well within this).
 ROTATION_TOLERANCE = 1e-5
-_MISSING = object()
+#: What `MetaReader.get` returns for a missing field it has reported: readers pass it on as
+#: None without reporting it again.
+ABSENT = object()
+_NO_DEFAULT = object()
 
 
 @dataclass(frozen=True)
@@ -85,23 +88,25 @@ class MetaReader:
 
     # --- values -------------------------------------------------------------------------
 
-    def get(self, obj: dict, key: str, where: str, default: Any = _MISSING) -> Any:
-        """obj[key]; a problem (and None) when it is missing and has no default."""
+    def get(self, obj: dict, key: str, where: str, default: Any = _NO_DEFAULT) -> Any:
+        """obj[key]; `default` when it is missing, or, without one, a problem and ABSENT."""
         if key in obj:
             return obj[key]
-        if default is _MISSING:
+        if default is _NO_DEFAULT:
             self.bad(f"{where}.{key}" if where else key, "missing")
-            return None
+            return ABSENT
         return default
 
     def mapping(self, v: Any, where: str) -> dict | None:
         if isinstance(v, dict):
             return v
-        if v is not None:  # None: already reported missing
-            self.bad(where, f"must be a JSON object, not {type(v).__name__}")
+        if v is not ABSENT:
+            self.bad(where, f"must be a JSON object, not {v!r}")
         return None
 
     def number(self, v: Any, where: str) -> float | None:
+        if v is ABSENT:
+            return None
         if isinstance(v, bool) or not isinstance(v, int | float):
             self.bad(where, f"must be a number, not {v!r}")
             return None
@@ -111,12 +116,16 @@ class MetaReader:
         return float(v)
 
     def flag(self, v: Any, where: str) -> bool | None:
+        if v is ABSENT:
+            return None
         if not isinstance(v, bool):
             self.bad(where, f"must be true or false, not {v!r}")
             return None
         return v
 
     def text(self, v: Any, where: str) -> str | None:
+        if v is ABSENT:
+            return None
         if not isinstance(v, str):
             self.bad(where, f"must be a string, not {v!r}")
             return None
@@ -131,6 +140,8 @@ class MetaReader:
         return v
 
     def array(self, v: Any, shape: tuple[int, ...], where: str) -> np.ndarray | None:
+        if v is ABSENT:
+            return None
         try:
             a = np.asarray(v, dtype=float)
         except (TypeError, ValueError):
@@ -194,7 +205,7 @@ class MetaReader:
         projector = None if raw_projector is None else self.projector(raw_projector)
         raw = self.get(meta, "captures", "")
         if not isinstance(raw, list) or not raw:
-            if raw is not None:
+            if raw is not ABSENT:
                 self.bad("captures", "must be a non-empty list")
             return None
         captures = [self.capture(c, f"captures[{i}]", cameras) for i, c in enumerate(raw)]
@@ -207,7 +218,7 @@ class MetaReader:
 
     def cameras(self, v: Any) -> tuple[str, ...]:
         if not isinstance(v, list) or not v:
-            if v is not None:
+            if v is not ABSENT:
                 self.bad("cameras", "must be a non-empty list of camera names")
             return ()
         names = [self.name(c, f"cameras[{i}]") for i, c in enumerate(v)]
@@ -221,6 +232,8 @@ class MetaReader:
         K = self.intrinsics(self.get(v, "K", "projector"), "projector.K")
         T = self.pose(self.get(v, "T_base_proj", "projector"), "projector.T_base_proj")
         size = [self.get(v, key, "projector") for key in ("width", "height")]
+        if ABSENT in size:
+            return None
         if not all(isinstance(s, int) and not isinstance(s, bool) and s > 0 for s in size):
             self.bad("projector", f"width and height must be positive pixel counts, not {size}")
             return None
