@@ -476,7 +476,8 @@ def serve_recording(args: argparse.Namespace) -> int:
     session = Session(RecordedRobot(recording), journal=journal)
     try:
         n = len(recording.captures)
-        _say(f"serving the recording {args.recorded} ({n} captures); it cannot move", err=True)
+        count = f"{n} capture" + ("s" if n != 1 else "")
+        _say(f"serving {args.recorded} ({count}): it cannot move; no 3D view", err=True)
         return run_api(create_app(session), args.host, args.port, None)
     finally:
         session.close()
