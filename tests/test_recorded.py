@@ -105,6 +105,13 @@ def test_record_refuses_an_unknown_object_or_a_used_directory(recorded, tmp_path
     assert "not an empty directory" in capsys.readouterr().err
 
 
+def test_serve_refuses_a_directory_that_is_no_recording(tmp_path, capsys):
+    assert cli.main(["serve", "--recorded", str(tmp_path)]) == cli.EXIT_USAGE
+    assert "meta.json: missing" in capsys.readouterr().err
+    with pytest.raises(SystemExit):  # a scene or a recording, not both
+        cli.main(["serve", "--scene", "kitchen", "--recorded", str(tmp_path)])
+
+
 def _tiny(captures: int = 2) -> Recording:
     """Two 4 x 6 cameras, `captures` captures: enough to break in every way."""
     K = np.array([[5.0, 0.0, 3.0], [0.0, 5.0, 2.0], [0.0, 0.0, 1.0]])
