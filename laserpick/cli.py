@@ -1,7 +1,8 @@
 """The `laserpick` console script.
 
     laserpick serve [--host 127.0.0.1] [--port 8000] [--viser-port 8080] [--scene isolation]
-                    [--journal FILE]
+                    [--journal FILE] [--recorded DIR]
+    laserpick record OUT --scene NAME [--seed S] [--aim-at-object INSTANCE]
     laserpick adapter switch|joystick ...
     laserpick bench --protocol P [--trials N] [--seed S] [--selection auto|manual]
                     [--strategy gpd|overhead|jeeves] [--scene FILE] [--out FILE.json]
@@ -17,6 +18,11 @@ Security: it binds the loopback interface by default. Binding anything else is r
 a robot; taking control then needs that password. The viser port has no authentication of its
 own, so on a non-loopback host the 3D view is view-only (no Pause button) and should sit
 behind the TLS proxy in deploy/.
+
+`serve --recorded DIR` serves a recording instead (`robot.recorded.RecordedRobot`): the
+pipeline runs on the recorded frames and nothing moves; no simulator is loaded, and the 3D
+view is not served. `record` writes such a recording from a scene simulated headless, with the
+laser confirmed on an object if asked (the format: docs/recording.md).
 
 `bench` reruns one of the papers' experiments with the scripted operator (docs/bench.md).
 
@@ -37,6 +43,12 @@ import sys
 import uuid
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from fastapi import FastAPI
+
+    from laserpick.server.journal import Journal
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
@@ -101,10 +113,17 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="SQLite journal of the session (default $XDG_DATA_HOME/laserpick/journal.sqlite3)",
     )
-    serve.add_argument(
+    world = serve.add_mutually_exclusive_group()
+    world.add_argument(
         "--scene",
         default="isolation",
         help="a built-in scene name (isolation, kitchen, surfaces, jeeves) or a YAML path",
+    )
+    world.add_argument(
+        "--recorded",
+        type=Path,
+        metavar="DIR",
+        help="serve this recording (laserpick record) instead of a simulated scene",
     )
     serve.add_argument("--viewer-rate", type=float, default=40.0, help="3D view updates (Hz)")
     serve.add_argument(
@@ -114,8 +133,28 @@ def build_parser() -> argparse.ArgumentParser:
         "lighting, flat shading (3x faster in software WebGL)",
     )
     serve.set_defaults(func=cmd_serve)
+    _add_record_parser(sub)
     _add_adapter_parser(sub)
     return parser
+
+
+def _add_record_parser(sub: argparse._SubParsersAction) -> None:
+    """`laserpick record OUT --scene NAME`: a recording from a scene simulated headless."""
+    record = sub.add_parser(
+        "record",
+        help="capture a simulated scene into a recording (serve it with serve --recorded)",
+        description="Load a scene headless, let it settle, optionally confirm the laser on an"
+        " object, capture once, and write the recording (format: docs/recording.md).",
+    )
+    record.add_argument("out", type=Path, metavar="OUT", help="a new (or empty) directory")
+    record.add_argument("--scene", required=True, help="a built-in scene name or a scene YAML path")
+    record.add_argument("--seed", type=int, help="the scene's random placement seed")
+    record.add_argument(
+        "--aim-at-object",
+        metavar="INSTANCE",
+        help="confirm the laser (both beams) on this object before capturing",
+    )
+    record.set_defaults(func=cmd_record)
 
 
 def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
@@ -302,6 +341,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
             _say(f"--{name.replace('_', '-')} {value} is not a TCP port", err=True)
             return EXIT_USAGE
 
+    if args.recorded is not None:
+        return serve_recording(args)
+
     # Heavy imports only once the arguments are sane: `laserpick --help` stays fast.
     from laserpick.robot.sim.scenes import load_scene
 
@@ -311,15 +353,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
         _say(f"cannot load scene {args.scene!r}: {exc}", err=True)
         return EXIT_USAGE
 
-    from laserpick.server.journal import Journal, JournalError
-
-    try:
-        journal = Journal(args.journal or default_journal(), session=uuid.uuid4().hex)
-    except (JournalError, OSError) as exc:
-        _say(f"cannot open the journal: {exc}", err=True)
+    journal = open_journal(args.journal)
+    if journal is None:
         return EXIT_USAGE
 
-    import uvicorn
     import viser
 
     from laserpick.console.operator_console import OperatorConsole
@@ -357,36 +394,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
                 err=True,
             )
         app = create_app(session, viser_port=viser_port, viser_url=args.viser_url)
-        config = uvicorn.Config(
-            app,
-            host=args.host,
-            port=args.port,
-            log_level="warning",
-            ws="websockets-sansio",
-        )
-        api = uvicorn.Server(config)
-
-        async def serve() -> None:
-            task = asyncio.create_task(api.serve())
-            while not api.started and not task.done():
-                await asyncio.sleep(0.05)
-            if api.started:
-                port = api.servers[0].sockets[0].getsockname()[1]
-                _say(f"console at http://{_url_host(args.host)}:{port}/")
-                _say(f"3D view at http://{_url_host(args.host)}:{viser_port}/")
-            await task
-
-        # uvicorn turns SIGINT and SIGTERM into a graceful shutdown, then raises the signal
-        # again with the handlers it found; with these no-op handlers in place, that second
-        # signal ends nothing, and the cleanup below (halt, journal) still runs.
-        previous = {sig: signal.signal(sig, lambda *_: None) for sig in STOP_SIGNALS}
-        try:
-            asyncio.run(serve())
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
-        _say("shutting down")
-        return 0 if api.started else 1
+        return run_api(app, args.host, args.port, viser_port)
     finally:
         if console is not None:
             console.stop()
@@ -396,6 +404,139 @@ def cmd_serve(args: argparse.Namespace) -> int:
         if server is not None:
             server.stop()
         journal.close()
+
+
+def open_journal(path: Path | None) -> Journal | None:
+    """The session's journal at `path` (default `default_journal()`), or None, said why."""
+    from laserpick.server.journal import Journal, JournalError
+
+    try:
+        return Journal(path or default_journal(), session=uuid.uuid4().hex)
+    except (JournalError, OSError) as exc:
+        _say(f"cannot open the journal: {exc}", err=True)
+        return None
+
+
+def run_api(app: FastAPI, host: str, port: int, viser_port: int | None) -> int:
+    """Serve `app` with uvicorn until SIGINT or SIGTERM; 0 once shut down, 1 if it never
+    started. Prints the console's URL (and the 3D view's) once the API is up."""
+    import uvicorn
+
+    config = uvicorn.Config(
+        app,
+        host=host,
+        port=port,
+        log_level="warning",
+        ws="websockets-sansio",
+    )
+    api = uvicorn.Server(config)
+
+    async def serve() -> None:
+        task = asyncio.create_task(api.serve())
+        while not api.started and not task.done():
+            await asyncio.sleep(0.05)
+        if api.started:
+            bound = api.servers[0].sockets[0].getsockname()[1]
+            _say(f"console at http://{_url_host(host)}:{bound}/")
+            if viser_port is not None:
+                _say(f"3D view at http://{_url_host(host)}:{viser_port}/")
+        await task
+
+    # uvicorn turns SIGINT and SIGTERM into a graceful shutdown, then raises the signal
+    # again with the handlers it found; with these no-op handlers in place, that second
+    # signal ends nothing, and the caller's cleanup (halt, journal) still runs.
+    previous = {sig: signal.signal(sig, lambda *_: None) for sig in STOP_SIGNALS}
+    try:
+        asyncio.run(serve())
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    _say("shutting down")
+    return 0 if api.started else 1
+
+
+def serve_recording(args: argparse.Namespace) -> int:
+    """`serve --recorded DIR`: the session on a `RecordedRobot`, the page and the API; no
+    simulator, no 3D view."""
+    from laserpick.robot.recorded import RecordedRobot
+    from laserpick.robot.recording import RecordingError, read_recording
+
+    try:
+        recording = read_recording(args.recorded)
+    except RecordingError as exc:
+        _say(str(exc), err=True)
+        return EXIT_USAGE
+    journal = open_journal(args.journal)
+    if journal is None:
+        return EXIT_USAGE
+
+    from laserpick.server.app import create_app
+    from laserpick.server.session import Session
+
+    session = Session(RecordedRobot(recording), journal=journal)
+    try:
+        n = len(recording.captures)
+        count = f"{n} capture" + ("s" if n != 1 else "")
+        _say(f"serving {args.recorded} ({count}): it cannot move; no 3D view", err=True)
+        return run_api(create_app(session), args.host, args.port, None)
+    finally:
+        session.close()
+        journal.close()
+
+
+def cmd_record(args: argparse.Namespace) -> int:
+    """Simulate a scene headless, let it settle, confirm the laser on an object if asked,
+    capture once, and write the recording to `args.out`."""
+    from laserpick.robot.sim.scenes import load_scene
+
+    out: Path = args.out
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        _say(f"{out} already exists and is not an empty directory; choose another", err=True)
+        return EXIT_USAGE
+    try:
+        scene = load_scene(args.scene, seed=args.seed)
+    except Exception as exc:
+        _say(f"cannot load scene {args.scene!r}: {exc}", err=True)
+        return EXIT_USAGE
+    instances = [p.instance for p in scene.placements]
+    target = args.aim_at_object
+    if target is not None and target not in instances:
+        _say(
+            f"scene {scene.name!r} has no object {target!r}; it has: {', '.join(instances)}",
+            err=True,
+        )
+        return EXIT_USAGE
+
+    from laserpick.pipeline.cloud import fuse
+    from laserpick.robot.recording import Hint, Recording, capture_from, write_recording
+    from laserpick.robot.sim.truth import capture
+
+    _say(f"simulating scene {scene.name!r} headless and letting it settle", err=True)
+    captured = capture(scene)
+    try:
+        hint = None
+        if target is not None:
+            top = captured.visible_top(fuse(captured.frames), target)
+            if top is None:
+                _say(f"no camera sees {target!r}: the laser cannot be aimed at it", err=True)
+                return 1
+            captured.robot.laser.aim_at(top)
+            captured.robot.laser.confirm()
+            hint = Hint(target, top)
+            where = ", ".join(f"{v:.3f}" for v in top)
+            _say(f"laser confirmed on {target!r}, its top at ({where}) m in base", err=True)
+        _say("capturing", err=True)
+        seed = "the scene's seed" if args.seed is None else f"seed {args.seed}"
+        recording = Recording(
+            (capture_from(captured.robot, hint),),
+            captured.robot.projector(),
+            source=f"laserpick record: scene {scene.name!r}, {seed}",
+        )
+        write_recording(out, recording)
+    finally:
+        captured.close()
+    _say(f"wrote {out}: 1 capture from {len(recording.cameras)} cameras", err=True)
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
