@@ -40,8 +40,8 @@ class Leaving(Withdrawing):
         it. Only with a clear way back: lowered first, a hand with none can find one lower,
         close along the surface, from where no way to ready is found. A hand whose open
         pads still press something (`pads_clear`) is lowered first from any approach: a
-        finger that dragged a mug by its handle as it opened lifted it 9 cm by it, and
-        lowered, came free. Pads that still feel anything then are eased off it sideways
+        finger that drags a mug by its handle as it opens lifts it 9 cm by it, and lowered
+        first, comes free. Pads that still feel anything then are eased off it sideways
         (`_slide_pads_off`), and the hand leaves from there: risen straight up, it goes up
         beside the way it came down, by as much as it was eased (at most `leave_shift`),
         unchecked as that way is."""

@@ -55,7 +55,7 @@ class Withdrawing(GuardedMotion):
         from above (within `withdraw_steep` of the vertical) leaves by rising instead.
         Not level: after a place, back along the approach itself, the fingers sliding off
         the object they let go of the way they came (drawn back level from 43 deg above the
-        side, they dragged a plush toy's head over).
+        side, they drag a plush toy's head over).
 
         A hand that starts within the checker's margin of something still leaves, if the
         whole way keeps the clearance it starts with: half the margin, or none short of
