@@ -13,6 +13,7 @@ from functools import lru_cache
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from laserpick.settings.behaviours import BehaviourSettings
 from laserpick.settings.grasp import GraspSettings
 from laserpick.settings.hardware import SensorSettings, SimSettings
 from laserpick.settings.motion import ApproachSettings, MotionSettings
@@ -21,6 +22,7 @@ from laserpick.settings.server import ServerSettings
 
 __all__ = [
     "ApproachSettings",
+    "BehaviourSettings",
     "GraspSettings",
     "MotionSettings",
     "PerceptionSettings",
@@ -43,6 +45,7 @@ class Settings(BaseSettings):
     grasp: GraspSettings = GraspSettings()
     approach: ApproachSettings = ApproachSettings()
     motion: MotionSettings = MotionSettings()
+    behaviour: BehaviourSettings = BehaviourSettings()
     server: ServerSettings = ServerSettings()
     operator_password: SecretStr | None = Field(
         None,

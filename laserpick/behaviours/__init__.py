@@ -1,0 +1,89 @@
+"""Behaviours: pick, carry, drop in the basket, place at a mark, put back, approach, executed
+on any `Robot`.
+
+Each checks its preconditions before it moves and its postconditions after (EL-E, 000
+section 4.6; the re-grip of 002), and ends in one `Outcome`: done, or a typed `Failure` with
+a sentence the user can read. A failed behaviour leaves the arm at rest, and never holding
+the gripper half closed on nothing. `Behaviours` is the one object the session drives: each
+behaviour is a class of its own module, all built on `GuardedMotion`. Their tunables are the
+settings' `behaviour` group (`BehaviourSettings`, `LASERPICK_BEHAVIOUR__*`).
+"""
+
+from __future__ import annotations
+
+from laserpick.behaviours.approach import Approaching
+from laserpick.behaviours.basket import BasketDrop
+from laserpick.behaviours.carry import Carrying, holding_pose, without_leftovers
+from laserpick.behaviours.drop_postures import (
+    basket_opening,
+    drop_candidates,
+    drop_configurations,
+    past_the_opening,
+    rank_drop_postures,
+)
+from laserpick.behaviours.guarded_motion import GuardedMotion
+from laserpick.behaviours.hand import GRIPPER_TIME
+from laserpick.behaviours.held import Held, WayIn
+from laserpick.behaviours.leave import Leaving
+from laserpick.behaviours.messages import (
+    MARK_MOVES,
+    NOT_HOLDING,
+    PAST_THE_OPENING,
+    crowded_message,
+)
+from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.pick import Picking
+from laserpick.behaviours.place import Placing
+from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses, turned_hand_xy
+from laserpick.behaviours.put_back import PuttingBack
+from laserpick.behaviours.stow import Stowing
+from laserpick.behaviours.withdraw import Withdrawing
+from laserpick.settings import BehaviourSettings
+
+__all__ = [
+    "GRIPPER_TIME",
+    "HOLD_TURNS",
+    "MARK_MOVES",
+    "NOT_HOLDING",
+    "PAST_THE_OPENING",
+    "SUPPORT_SCATTER",
+    "Approaching",
+    "BasketDrop",
+    "Behaviours",
+    "Carrying",
+    "GuardedMotion",
+    "Held",
+    "Leaving",
+    "Outcome",
+    "Picking",
+    "PlacePoses",
+    "Placing",
+    "PuttingBack",
+    "Stowing",
+    "WayIn",
+    "Withdrawing",
+    "basket_opening",
+    "crowded_message",
+    "drop_candidates",
+    "drop_configurations",
+    "front_wall",
+    "holding_pose",
+    "past_the_opening",
+    "place_poses",
+    "rank_drop_postures",
+    "turned_hand_xy",
+    "without_leftovers",
+]
+
+#: The default of `BehaviourSettings.support_scatter` (m), for callers not yet reading the
+#: settings.
+SUPPORT_SCATTER: float = BehaviourSettings.model_fields["support_scatter"].default
+#: The default of `BehaviourSettings.hold_turns` (rad), for callers not yet reading the
+#: settings.
+HOLD_TURNS: tuple[float, ...] = BehaviourSettings.model_fields["hold_turns"].default
+
+
+class Behaviours(Picking, BasketDrop, Placing, PuttingBack, Approaching):
+    """The robot's behaviours, run one at a time from the caller's thread: `pick`, `tuck`,
+    `drop_in_basket`, `place`, `put_back`, `approach`, `go_ready` and `stow`, on the
+    `Robot` given (see `GuardedMotion` for the arguments). `held` is what the hand holds."""

@@ -1,0 +1,182 @@
+"""Where the arm can hold an object over the basket to let it go: the candidate postures
+(computed once: the basket is fixed to the scooter), and their ranking for one object."""
+
+from __future__ import annotations
+
+import functools
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import CollisionChecker, held_at
+from laserpick.settings import BehaviourSettings, get_settings
+from laserpick.transforms import roty, rotz
+
+__all__ = [
+    "basket_opening",
+    "drop_candidates",
+    "drop_configurations",
+    "past_the_opening",
+    "rank_drop_postures",
+]
+
+#: A rank key: (past the opening?, coarse fall, steps past, fall, nearness to the reference).
+DropRank = tuple[int, int, int, int, float]
+
+
+def drop_candidates(
+    tilted: bool = False, heights: Sequence[float] | None = None
+) -> tuple[np.ndarray, ...]:
+    """Joint configurations for releasing over the basket, the arm clear of the scooter (rad).
+
+    Upright (the default): the TCP over (or just inside) the basket's opening, the gripper
+    pointing down or tilted up to 30 deg. Tilted: the gripper tilted 45-90 deg from down,
+    toward any side, its TCP up to 20 cm beside the opening: for a tall object held at its
+    top, which hangs too deep below a downward hand for any reachable height (the arm
+    reaches at most 26 cm above the rim pointing down), so it is laid over the opening
+    instead. heights: the TCP's heights over the rim (m; default: the settings'
+    `drop_heights`). Computed once for each: the basket is fixed to the scooter.
+    """
+    if heights is None:
+        heights = get_settings().behaviour.drop_heights
+    return _drop_candidates(tilted, tuple(heights))
+
+
+@functools.cache
+def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarray, ...]:
+    centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
+    rim = centre[2] + inner[2] / 2
+    free = CollisionChecker(np.zeros((0, 3)))
+    if tilted:
+        offsets = np.linspace(-0.2, 0.2, 5)
+        grid = itertools.product(
+            offsets,
+            offsets,
+            heights,
+            np.radians(np.arange(0, 360, 30)),
+            np.radians((45, 60, 75, 90)),
+        )
+    else:
+        grid = itertools.product(
+            np.linspace(-0.3, 0.3, 3) * inner[0],
+            np.linspace(-0.3, 0.3, 3) * inner[1],
+            heights,
+            np.radians(np.arange(0, 180, 30)),
+            np.radians((0, 15, 30)),
+        )
+    out = []
+    for dx, dy, dz, yaw, tilt in grid:
+        T = np.eye(4)
+        T[:3, :3] = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down
+        T[:3, 3] = [centre[0] + dx, centre[1] + dy, rim + dz]
+        Q = ik_tcp(T, dims.UR5_READY_Q)
+        out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
+    return tuple(out)
+
+
+def drop_configurations(
+    q_ref: np.ndarray,
+    checker: CollisionChecker,
+    payload: np.ndarray,
+    falls: np.ndarray | None = None,
+    *,
+    settings: BehaviourSettings,
+) -> list[np.ndarray]:
+    """Clear joint configurations that hold the object over the basket's opening, best
+    first (rad): those of `drop_candidates()`, and where fewer than `drop_tries` of them
+    hold the whole object inside, the tilted ones after them (an object that fits inside
+    from one upright posture only stays in the hand where no path reaches that one).
+
+    payload (P, 3), TCP frame (m): the points kept clear of everything, as carried.
+    falls (F, 3), TCP frame (m): the object as it falls when let go (default `payload`):
+    less the part that stands in for what the view cut off (`Held.as_seen_tcp`), which
+    would pull the middle it is held by off the real object's, and let it fall beside the
+    basket.
+
+    Postures that hold every point of the object inside the opening (1 cm in from the
+    walls) come first, upright before tilted, each by the shortest fall (in `fall_step`
+    steps: a long fall bounces the object out), then the nearest to q_ref. Then those
+    that hold its middle there, upright and tilted together (`rank_drop_postures`).
+    A posture that does not hold even the middle over the opening is left out: an object
+    let go there would fall beside the basket, onto the scooter or the floor. Empty when
+    none is left.
+    The basket sits close beside the arm's base, between the tiller, the sensor posts and
+    the projector, so few postures reach over it: they are searched, not assumed.
+    """
+    falls = payload if falls is None else falls
+    upright = drop_candidates(heights=settings.drop_heights)
+    ranked = rank_drop_postures(upright, q_ref, checker, payload, falls, settings)
+    if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
+        tilted = drop_candidates(tilted=True, heights=settings.drop_heights)
+        ranked += rank_drop_postures(tilted, q_ref, checker, payload, falls, settings)
+        inside = [kq for kq in ranked if kq[0][0] == 0]
+        past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
+        ranked = inside + past
+    return [q for _, q in ranked]
+
+
+def basket_opening() -> tuple[np.ndarray, np.ndarray]:
+    """The basket's opening, 1 cm in from its walls: its lower and upper corners (m, `base`
+    xy)."""
+    half = dims.BASKET_INNER[:2] / 2
+    return dims.BASKET_CENTER[:2] - half + 0.01, dims.BASKET_CENTER[:2] + half - 0.01
+
+
+def past_the_opening(held: np.ndarray) -> np.ndarray:
+    """How far (m) each point of `held` (..., 3) (m, `base`) lies past the basket's opening,
+    across: 0 over it."""
+    lo, hi = basket_opening()
+    xy = held[..., :2]
+    return np.maximum(np.maximum(lo - xy, xy - hi), 0.0).max(axis=-1)
+
+
+def rank_drop_postures(
+    candidates: Sequence[np.ndarray],
+    q_ref: np.ndarray,
+    checker: CollisionChecker,
+    payload: np.ndarray,
+    falls: np.ndarray,
+    settings: BehaviourSettings,
+) -> list[tuple[DropRank, np.ndarray]]:
+    """The clear `candidates` (clear with `payload`, TCP frame, m) that hold the middle of
+    the object as it falls (`falls`, TCP frame, m) over the opening, each with its rank key,
+    sorted. Wholly inside the opening: (0, 0, 0, fall, nearness); partly past it: (1,
+    coarse fall, steps past, fall, nearness). The fall is the object's lowest point over the
+    basket's floor in `fall_step` steps (coarse: `overhang_fall_step`), the reach past the
+    opening in `overhang_step` steps, and nearness the largest joint's distance from
+    `q_ref` (rad)."""
+    if not candidates:
+        return []
+    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    Q = np.array(candidates)
+    T = tcp_pose(Q)
+    pts = falls if len(falls) else np.zeros((1, 3))
+    held = held_at(T, pts)  # (B, P, 3)
+    middle_in = past_the_opening(held.mean(axis=1)) == 0
+    Q, held = Q[middle_in], held[middle_in]
+    # In chunks: the check's arrays grow with candidates x payload points x spheres.
+    clear = np.concatenate(
+        [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
+        or [np.zeros(0, bool)]
+    )
+    past = past_the_opening(held).max(axis=1)
+    # In steps, 0 where wholly inside; the 1e-9 keeps float noise from adding a step.
+    past = np.ceil(past / settings.overhang_step - 1e-9).astype(int)
+    drop = held[..., 2].min(axis=1) - floor
+    fall = (drop // settings.fall_step).astype(int)
+    coarse = (drop // settings.overhang_fall_step).astype(int)
+    near = np.max(np.abs(Q - q_ref), axis=1)
+    ranked = [
+        (
+            (0, 0, 0, int(fall[i]), float(near[i]))
+            if past[i] == 0
+            else (1, int(coarse[i]), int(past[i]), int(fall[i]), float(near[i])),
+            Q[i],
+        )
+        for i in np.flatnonzero(clear)
+    ]
+    ranked.sort(key=lambda kq: kq[0])
+    return ranked

@@ -1,0 +1,173 @@
+"""Guarded motion: what every behaviour is built on. `GuardedMotion` holds the robot, the
+settings, what the hand holds, and runs trajectories on the arm: it waits for the arm to
+reach a trajectory's start, reads a protective stop, and backs the arm away after one.
+
+A failed motion ends in a `Failure` with a sentence the user can read, never a bare
+controller message."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from laserpick.behaviours.hand import GRIPPER_TIME
+from laserpick.behaviours.held import Held, WayIn
+from laserpick.behaviours.outcome import Outcome
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.plan import cartesian_line, joint_path, timed
+from laserpick.robot.interface import PROTECTIVE_STOP, Robot
+from laserpick.settings import Settings, get_settings
+from laserpick.types import Failure, Trajectory
+
+__all__ = ["GuardedMotion"]
+
+log = logging.getLogger(__name__)
+
+
+class GuardedMotion:
+    """The arm's motions as the behaviours run them, one at a time from the caller's thread.
+
+    progress: called with a short sentence at each step, for the console and logs.
+    should_stop: polled before every motion; once it returns True (the operator cancelled,
+    or the watchdog fired) no new motion starts and the behaviour ends with a failure.
+    held: what the hand holds (None: nothing); way_in: how it came to hold it, while that
+    way is known (every motion since the grasp ran to its end).
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        settings: Settings | None = None,
+        rng: np.random.Generator | None = None,
+        progress: Callable[[str], None] | None = None,
+        should_stop: Callable[[], bool] | None = None,
+    ) -> None:
+        self.robot = robot
+        self.should_stop = should_stop or (lambda: False)
+        self.settings = settings or get_settings()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.progress = progress or (lambda msg: log.info(msg))
+        self.held: Held | None = None
+        self.way_in: WayIn | None = None
+
+    def current_q(self) -> np.ndarray:
+        """The arm's joint angles now (6,) (rad)."""
+        return self.robot.joint_state().q
+
+    def run(self, traj: Trajectory, what: str) -> Failure | None:
+        """Run `traj` to its end; None when it got there, else why not, in a sentence that
+        names `what` the motion was doing. The arm first catches up with the start (a
+        trajectory ends by its clock while the servos may still lag, and the controller
+        refuses a start 0.05 rad off). A protective stop backs the arm away the way it came
+        (`_retrace_after_stop`); a motion over its time is halted."""
+        b = self.settings.behaviour
+        if self.should_stop():
+            return Failure("execute", f"Stopped before {what}: the motion was cancelled.")
+        waited = 0.0
+        while (
+            np.max(np.abs(self.current_q() - traj.q[0])) > b.start_tolerance
+            and waited < b.start_wait
+        ):
+            self.robot.sleep(0.05)
+            waited += 0.05
+        if np.max(np.abs(self.current_q() - traj.q[0])) > b.start_stuck:
+            self.robot.halt()
+            self.way_in = None
+            return Failure(
+                "execute",
+                f"The arm stopped short of where {what} starts: it may be touching something.",
+            )
+        handle = self.robot.execute(traj)
+        status = self.robot.wait(handle, traj.duration + b.motion_slack)
+        if status == "done":
+            if self.way_in is not None and self.held is not None:
+                self.way_in = replace(self.way_in, driven=(*self.way_in.driven, traj.q))
+            return None
+        self.way_in = None  # stopped part way: the way back is no longer known
+        if status == "running":
+            self.robot.halt()  # not the latching e-stop: that one stays the user's
+            return Failure("execute", f"The arm did not finish {what} in time; it was stopped.")
+        if handle.message.startswith(PROTECTIVE_STOP):
+            felt = handle.message.removeprefix(PROTECTIVE_STOP)
+            done = "stopped and backed away" if self._retrace_after_stop(traj) else "stopped"
+            return Failure("execute", f"The arm was pushed back while {what} ({felt}): {done}.")
+        return Failure("execute", f"The arm stopped while {what}: {handle.message}.")
+
+    def _retrace_after_stop(self, traj: Trajectory) -> bool:
+        """After a protective stop on `traj`, go back the way it came to where it started:
+        the arm was there a moment ago, so that way is clear, and the arm is then neither
+        pressed against what it met nor left standing in the cameras' view (where it hides
+        the next mark's object from them). Not when the user has cancelled: the arm then
+        stays where it stopped. Returns whether it got back."""
+        if self.should_stop():
+            return False
+        b = self.settings.behaviour
+        q = self.current_q()
+        reached = int(np.argmin(np.max(np.abs(traj.q - q), axis=1)))
+        back = np.vstack([q, traj.q[reached::-1]])
+        # Keep the turning points, about back_step apart: a trajectory is sampled densely.
+        moved = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(back, axis=0)), axis=1))])
+        keep = np.flatnonzero(np.diff(np.floor(moved / b.back_step), prepend=-1) > 0)
+        path = back[np.union1d(keep, [len(back) - 1])]
+        if len(path) < 2 or np.max(np.abs(path[-1] - q)) < b.start_tolerance:
+            return True
+        way_back = timed(path, self.settings.motion)
+        handle = self.robot.execute(way_back)
+        return self.robot.wait(handle, way_back.duration + b.motion_slack) == "done"
+
+    def go_to(
+        self,
+        q_goal: np.ndarray,
+        checker: CollisionChecker,
+        what: str,
+        via: Sequence[np.ndarray] = (),
+        **kw,
+    ) -> Outcome:
+        """A collision-free joint move to q_goal (6,) rad; when no path is found, through
+        each configuration of `via` in turn (two shorter searches instead of one long).
+        kw: passed to `joint_path` (`payload`, TCP frame: what the hand carries, which also
+        slows the move to `carry_joint_speed`)."""
+        s, q = self.settings.motion, self.current_q()
+        path = joint_path(q, q_goal, checker, self.rng, s, **kw)
+        for q_via in via:
+            if path is not None:
+                break
+            first = joint_path(q, q_via, checker, self.rng, s, **kw)
+            second = (
+                joint_path(q_via, q_goal, checker, self.rng, s, **kw) if first is not None else None
+            )
+            path = None if second is None else np.vstack([first, second[1:]])
+        if path is None:
+            return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
+        carrying = kw.get("payload") is not None
+        speed = s.carry_joint_speed if carrying else None
+        return Outcome(self.run(timed(path, s, joint_speed=speed), what))
+
+    def descend(
+        self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0
+    ) -> Failure | None:
+        """Run the straight way down `path` (N, 6) at `tcp_speed` (m/s), guarded: where the
+        hand or what it holds feels more than `place_contact_force` over the `felt` (N) it
+        already bears at the start, it stops there, and the failure says what it met."""
+        s = self.settings.motion
+        down = timed(path, s, tcp_speed=tcp_speed)
+        guard = s.place_contact_force + felt
+        return self.run(Trajectory(down.times, down.q, guard_force=guard), what)
+
+    def rise_straight(self, T: np.ndarray, what: str) -> None:
+        """Rise in a straight line to TCP pose T (4, 4, `base`) at the approach speed, if the
+        arm can (no check for collisions: the way back up is the way it came down)."""
+        s = self.settings.motion
+        up = cartesian_line(self.current_q(), T, s.cartesian_step)
+        if up is not None:
+            self.run(timed(up, s, tcp_speed=s.approach_speed), what)
+
+    def release(self) -> None:
+        """Open the hand and give it the time to open: it holds nothing from here."""
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        self.held = None
+        self.way_in = None

@@ -1,0 +1,33 @@
+"""The gripper as the behaviours use it: how long it takes, and what its pads feel."""
+
+from __future__ import annotations
+
+from laserpick.description import dims
+from laserpick.robot.interface import Robot
+
+__all__ = ["GRIPPER_TIME", "closed_on_something", "pad_force", "peak_pad_force"]
+
+#: Time (s) the gripper gets to close or open: the full 85 mm stroke at 0.15 m/s, plus margin.
+GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
+
+
+def pad_force(robot: Robot) -> float:
+    """What the pads press on (N): the gripper's own sensing, summed over both pads."""
+    return robot.gripper_state().force
+
+
+def peak_pad_force(robot: Robot, seconds: float, period: float) -> float:
+    """The most the pads feel (N) over the next `seconds` of robot time, read every `period`
+    (s). One reading flickers: a pad pressed against a rail read 0 N, then 0.95 N a tenth
+    of a second later."""
+    most = pad_force(robot)
+    for _ in range(round(seconds / period)):
+        robot.sleep(period)
+        most = max(most, pad_force(robot))
+    return most
+
+
+def closed_on_something(robot: Robot) -> bool:
+    """Whether the closed gripper's fingers stand apart, on something (not on each other)."""
+    state = robot.gripper_state()
+    return state.closed and state.width > dims.GRIPPER_EMPTY_GAP

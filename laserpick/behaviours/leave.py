@@ -1,0 +1,115 @@
+"""Letting go of what the hand set down, and taking the open hand off it: eased off the
+surface first, then drawn back along the approach or risen straight up, freeing a pad that
+something still leans on or presses."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from laserpick.behaviours.hand import pad_force, peak_pad_force
+from laserpick.behaviours.withdraw import Withdrawing
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.types import Failure, Trajectory
+
+__all__ = ["Leaving"]
+
+
+class Leaving(Withdrawing):
+    """Easing off the surface (`ease_off_surface`) and leaving what the hand let go of
+    (`leave_object`)."""
+
+    def ease_off_surface(self) -> None:
+        """Rise `place_ease` straight up from where a guarded descent felt the surface under
+        what the hand holds: let go there, with no drop to roll from, but not pressed into
+        the surface (`MotionSettings.place_ease`)."""
+        eased = tcp_pose(self.current_q())
+        eased[2, 3] += self.settings.motion.place_ease
+        self.rise_straight(eased, "easing off the surface")
+
+    def leave_object(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
+        """Take the open hand off what it has just set down: drawn back along its approach
+        if that way is clear of `checker` (which leaves the object out: the fingers start
+        about it), else straight up to the TCP pose T_above (4, 4, `base`), the way it came
+        down. Risen straight up from the side, the hand stays about a tall box's top, and no
+        way to ready is found.
+
+        A hand within `leave_level` of level with a clear way back is first lowered
+        `leave_drop` (`_lower_open_hand`), so that a pad under a lip of the object leaves
+        it. Only with a clear way back: lowered first, a hand with none can find one lower,
+        close along the surface, from where no way to ready is found. A hand whose open
+        pads still press something (`pads_clear`) is lowered first from any approach: a
+        finger that drags a mug by its handle as it opens lifts it 9 cm by it, and lowered
+        first, comes free. Pads that still feel anything then are eased off it sideways
+        (`_slide_pads_off`), and the hand leaves from there: risen straight up, it goes up
+        beside the way it came down, by as much as it was eased (at most `leave_shift`),
+        unchecked as that way is."""
+        start = tcp_pose(self.current_q())
+        approach = start[:3, 2]
+        back = self.withdrawal_path(approach, checker, level=False)
+        level = abs(approach[2]) < np.sin(self.settings.behaviour.leave_level)
+        pressed = self._pads_still_pressed()
+        if pressed or (back is not None and level):
+            self._lower_open_hand(start)
+            back = self.withdrawal_path(approach, checker, level=False)
+        eased = np.zeros(3)
+        if pressed:  # even if lowered they feel nothing: what leaned on a pad still leans
+            eased = self._slide_pads_off()
+            back = self.withdrawal_path(approach, checker, level=False)
+        if back is None:
+            T_up = T_above.copy()
+            T_up[:3, 3] += eased
+            self.rise_straight(T_up, "rising from the object")
+            return None
+        return self.run_withdrawal(back)
+
+    def _pads_still_pressed(self) -> bool:
+        """Whether the open hand's pads still press what they let go of (or anything): more
+        than `pads_clear` over `leave_settle`."""
+        b = self.settings.behaviour
+        return peak_pad_force(self.robot, b.leave_settle, b.feel_period) > b.pads_clear
+
+    def _slide_pads_off(self) -> np.ndarray:
+        """Ease the open hand sideways off what its pads touched, and say how far it moved
+        (3,) (m, `base`).
+
+        Along the closing axis by `leave_shift`, one way and, where the pads still feel
+        something there, the other, slowly and guarded at `leave_nudge` over what the pads
+        bear: the gripper feels only the pads' summed force, not which pad, so the way into
+        the object is found by touch, and stopped before it pushes the object over."""
+        s, b = self.settings.motion, self.settings.behaviour
+        start = tcp_pose(self.current_q())
+        for sign in (1.0, -1.0):
+            T = start.copy()
+            T[:3, 3] += sign * b.leave_shift * start[:3, 1]
+            path = cartesian_line(self.current_q(), T, s.cartesian_step / 5)
+            if path is None:
+                continue
+            aside = timed(path, s, tcp_speed=b.leave_speed)
+            guard = pad_force(self.robot) + b.leave_nudge
+            # Stopped at the guard is how the way into the object is found: not a failure.
+            self.run(Trajectory(aside.times, aside.q, guard_force=guard), "easing the pads off")
+            if not self._pads_still_pressed():
+                break
+        # Touching either way, it leaves from where it is: pushed back between, unguarded,
+        # the hand pushes what followed the pad.
+        return tcp_pose(self.current_q())[:3, 3] - start[:3, 3]
+
+    def _lower_open_hand(self, start: np.ndarray) -> None:
+        """Lower the open hand `leave_drop` straight down from TCP pose `start` (4, 4,
+        `base`), guarded as the place's descent: a pad whose top edge is under a lip of what
+        it let go of leaves it, rather than lifting it by it on the way out. A hand that
+        comes down on something instead (a shoulder of the object, the surface) goes back up
+        to `start`: drawn back from there, a finger drags what it met."""
+        s, b = self.settings.motion, self.settings.behaviour
+        T = start.copy()
+        T[2, 3] -= b.leave_drop
+        down = cartesian_line(self.current_q(), T, s.cartesian_step / 5)
+        if down is None:
+            return
+        felt = pad_force(self.robot)
+        met = self.descend(down, b.leave_speed, "freeing the fingers", felt=felt)
+        self.robot.sleep(b.leave_settle)  # the servos lag the trajectory's clock
+        if met is not None:
+            self.rise_straight(start, "rising off what the fingers met")

@@ -1,0 +1,136 @@
+"""The pick (004 section 7.4): try the grasps in score order and execute the first that
+plans; move to the pre-grasp; approach in a straight, guarded line (an unexpected contact
+stops the arm, which then backs off); close; lift 2 cm and close again (the re-grip of
+002); lift 10 cm; check the hold (EL-E, 000 section 4.6); from the side, draw back out."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+
+from laserpick.behaviours.carry import without_leftovers
+from laserpick.behaviours.hand import GRIPPER_TIME, closed_on_something
+from laserpick.behaviours.held import Held, WayIn
+from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.withdraw import Withdrawing
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.grasping import GraspSet, plan_first
+from laserpick.pipeline.plan import PickPlan, cartesian_line, timed
+from laserpick.pipeline.reach import pregrasp_pose
+from laserpick.types import Failure, Grasp, Trajectory
+
+__all__ = ["Picking"]
+
+
+class Picking(Withdrawing):
+    """The pick (`pick`)."""
+
+    def pick(self, grasps: GraspSet, order: Sequence[Grasp] | None = None) -> Outcome:
+        """Pick with the first grasp of `order` (default: all, in score order) that plans.
+        Done, the hand holds the object (`held`), lifted and, from the side, drawn back."""
+        s = self.settings.motion
+        if self.robot.gripper_state().holding:
+            return Outcome(Failure("precondition", "The hand is already holding something."))
+        order = list(order) if order is not None else grasps.ordered()
+        self.way_in = None
+        t0 = time.perf_counter()
+        plan, grasp, attempts = plan_first(grasps, self.current_q(), self.rng, order, s)
+        timings = {"plan": time.perf_counter() - t0}
+        if isinstance(plan, Failure):
+            msg = f"None of the {attempts} grasps could be planned ({plan.message})"
+            return Outcome(Failure("ik_plan", msg), attempts=attempts, timings=timings)
+        self.progress(f"Grasp {attempts} of {len(order)} planned; moving to it.")
+        failure = self._reach_and_close(plan)
+        if failure:
+            return Outcome(failure, grasp, attempts, timings)
+        # Held from here on, so that a cancel or an e-stop while lifting still knows what
+        # the hand has (the object's points travel with it in later collision checks).
+        held = self._take_hold(grasps, grasp, plan)
+        failure, closed = self._regrip_and_lift(plan)
+        if failure:
+            if not self.should_stop():  # a cancel or an e-stop keeps what the hand holds
+                self.release()
+            return Outcome(failure, grasp, attempts, timings, closed_width=closed)
+        failure = self.withdraw(grasp.approach, held.surroundings, held.points_tcp)
+        if failure:  # the hand keeps what it holds: the session tucks it in
+            return Outcome(failure, grasp, attempts, timings, closed_width=closed)
+        self.progress("Holding the object.")
+        return Outcome(None, grasp, attempts, timings, closed_width=closed)
+
+    def _reach_and_close(self, plan: PickPlan) -> Failure | None:
+        """Open the hand, move to the pre-grasp, approach guarded, and close: None when the
+        gripper closed on something. Met on the way in, the hand backs off; closed on
+        nothing, it opens and retreats."""
+        s = self.settings.motion
+        self.robot.gripper(False)
+        failure = self.run(plan.transit, "moving to the grasp")
+        if failure:
+            return failure
+        guarded = Trajectory(
+            plan.approach.times, plan.approach.q, plan.approach.gripper, guard_force=s.guard_force
+        )
+        failure = self.run(guarded, "approaching the object")
+        if failure and "unexpected contact" in failure.message:
+            self._back_off_along_approach()
+            touched = failure.message.split("unexpected contact: ", 1)[1].rstrip(".")
+            msg = f"The hand touched something on its way in ({touched}), stopped and backed off."
+            return Failure("execute", msg)
+        if failure:
+            return failure
+        self.progress("Closing the gripper.")
+        self.robot.gripper(True)
+        self.robot.sleep(GRIPPER_TIME)
+        if not closed_on_something(self.robot):
+            self._open_and_retreat(plan)
+            return Failure("execute", "The gripper closed on nothing.")
+        return None
+
+    def _take_hold(self, grasps: GraspSet, grasp: Grasp, plan: PickPlan) -> Held:
+        """Record what the closed hand now holds (`held`) and the way it came (`way_in`):
+        the object's carried shape in the TCP frame, and its surroundings less its own
+        leftovers (`without_leftovers`)."""
+        support = grasps.stands_on
+        pts = grasps.carried
+        pts_tcp = grasp.in_hand(pts)
+        scatter = self.settings.behaviour.support_scatter
+        around = without_leftovers(grasps.surroundings, pts, support, scatter)
+        height = float(grasp.position[2] - support)
+        middle = grasp.in_hand(grasps.middle[None])[0]
+        seen_tcp = grasp.in_hand(grasps.carried_as_seen) if len(grasps.cut_off) else None
+        self.held = Held(grasp, height, pts_tcp, middle, around, self.robot.base_pose(), seen_tcp)
+        self.way_in = WayIn(self.robot.base_pose(), plan.approach.q)
+        return self.held
+
+    def _regrip_and_lift(self, plan: PickPlan) -> tuple[Failure | None, float]:
+        """002's re-grip: lift a little, so the object hangs in the hand, and squeeze again;
+        then the full lift. Returns why it failed (None: lifted, still holding) and the
+        finger gap (m) after the second squeeze."""
+        s = self.settings.motion
+        failure = self.run(plan.regrip, "lifting") if s.regrip_lift > 0 else None
+        self.robot.gripper(True)
+        self.robot.sleep(0.3)
+        closed = self.robot.gripper_state().width
+        failure = failure or self.run(plan.lift, "lifting")
+        self.robot.sleep(0.3)
+        if failure is None and not self.robot.gripper_state().holding:
+            failure = Failure("execute", "The object slipped out of the hand while lifting.")
+        return failure, closed
+
+    def _back_off_along_approach(self) -> None:
+        """After a stopped approach: straight back along the approach axis by `backoff`."""
+        q = self.current_q()
+        T = tcp_pose(q)
+        T_back = pregrasp_pose(T, self.settings.motion.backoff)
+        path = cartesian_line(q, T_back, self.settings.motion.cartesian_step)
+        if path is not None:
+            self.run(timed(path, self.settings.motion, tcp_speed=0.05), "backing off")
+
+    def _open_and_retreat(self, plan: PickPlan) -> None:
+        """After closing on nothing: open the hand and go back to the pre-grasp pose."""
+        self.robot.gripper(False)
+        self.robot.sleep(GRIPPER_TIME)
+        back = cartesian_line(
+            self.current_q(), tcp_pose(plan.approach.q[0]), self.settings.motion.cartesian_step
+        )
+        if back is not None:
+            self.run(timed(back, self.settings.motion, tcp_speed=0.1), "retreating")

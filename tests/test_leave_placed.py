@@ -1,0 +1,232 @@
+"""Leaving a placed object: the open hand is drawn back the way it holds it, lowered off a
+lip, and eased sideways off what still leans on a pad."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from arm_setups import (
+    BEHAVIOUR,
+    DATA,
+    RAIL_TOP,
+    TABLE_TOP,
+    hand_at,
+    isolation_robot,
+    post_behind,
+    side_pose,
+    top_down,
+)
+
+from laserpick.behaviours import Behaviours
+from laserpick.bench.operator import Referee
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.robot.sim.robot import SimRobot
+from laserpick.robot.sim.scenes import load_scene
+from laserpick.types import Failure, Trajectory
+
+
+@pytest.fixture
+def robot():
+    yield from isolation_robot()
+
+
+def recorded_moves(b: Behaviours) -> list[str]:
+    """The list to which each motion `b` runs from now on adds what it is ("drawing
+    back", ...)."""
+    moves: list[str] = []
+    run = b.run
+
+    def record(traj: Trajectory, what: str) -> Failure | None:
+        moves.append(what)
+        return run(traj, what)
+
+    b.run = record  # type: ignore[method-assign]
+    return moves
+
+
+def test_after_a_place_the_open_hand_leaves_the_object_the_way_it_holds_it(robot):
+    """Drawn back off the object along the approach: from the side, straight up, the
+    fingers would stay about a tall box's top. From the side, with the way back clear, the
+    open hand is first lowered `leave_drop`, so that a pad under a lip of the object leaves
+    it (a pill bottle's cap). From above, or where the way back is not clear, straight up to the
+    pose above the place, the way it came down; neither is lowered first."""
+    b = Behaviours(robot)
+    moves = recorded_moves(b)
+    free = CollisionChecker(np.zeros((0, 3)))
+    q_side, above = hand_at(b, side_pose(1.70, -0.30, 0.80))
+    moves.clear()
+    assert b.leave_object(above, free) is None
+    assert moves == ["freeing the fingers", "drawing back"]
+    end = tcp_pose(robot.joint_state().q)[:3, 3]
+    np.testing.assert_allclose(end[:2], [1.60, -0.30], atol=0.005)
+    drop = BEHAVIOUR.leave_drop
+    assert 0.80 - drop - 0.001 < end[2] < 0.80 - drop / 2  # the servos lag
+    # Where the way back is not clear: up instead.
+    hand_at(b, side_pose(1.70, -0.30, 0.80))
+    moves.clear()
+    assert b.leave_object(above, post_behind(q_side)) is None
+    assert moves == ["rising from the object"]
+    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
+    _, above = hand_at(b, top_down(1.6, -0.3, 0.8))  # its approach is straight down
+    moves.clear()
+    assert b.leave_object(above, free) is None
+    assert moves == ["drawing back"]
+    np.testing.assert_allclose(tcp_pose(robot.joint_state().q)[:3, 3], above[:3, 3], atol=0.005)
+    # From 45 deg above the side: back along the approach itself, up and back, not level
+    # (drawn back level, the fingers drag a plush toy's head over), and not lowered.
+    oblique = np.eye(4)
+    approach = np.array([np.sqrt(0.5), 0.0, -np.sqrt(0.5)])
+    across = np.array([0.0, 1.0, 0.0])
+    oblique[:3, :3] = np.column_stack([np.cross(across, approach), across, approach])
+    oblique[:3, 3] = [1.6, -0.3, 0.8]
+    _, above = hand_at(b, oblique)
+    moves.clear()
+    assert b.leave_object(above, free) is None
+    assert moves == ["drawing back"]
+    moved = tcp_pose(robot.joint_state().q)[:3, 3] - oblique[:3, 3]
+    assert np.linalg.norm(moved) > 0.045  # 10 cm, or 5 where the whole way is not clear
+    np.testing.assert_allclose(moved / np.linalg.norm(moved), -approach, atol=0.05)
+
+
+def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back():
+    """Lowered `leave_drop` from the side, open fingers can come down on a jar's shoulder,
+    and drawn back from there, drag it (196 N, a protective stop). Here the open hand
+    stands level 2 mm over a table top: lowered, it meets the table, stops, goes back up
+    to where it stood, and is drawn back from there, level."""
+    robot = SimRobot(load_scene(str(DATA / "table_top.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        b = Behaviours(robot)
+        run = b.run  # the setup's own moves, not recorded
+        moves = recorded_moves(b)
+        top = np.mgrid[1.30:1.90:0.02, -0.65:0.35:0.02].reshape(2, -1).T
+        table = CollisionChecker(np.c_[top, np.full(len(top), TABLE_TOP)], margin=0.0)
+        high = side_pose(1.70, -0.30, TABLE_TOP + 0.06)
+        q = next(q for q in ik_tcp(high, dims.UR5_READY_Q) if table.clearance_ok(q)[0])
+        assert b.go_to(q, table, "test").ok
+        s = b.settings.motion
+        # Down onto the table until it is felt, then 2 mm back up off it.
+        low = high.copy()
+        low[2, 3] = TABLE_TOP
+        path = cartesian_line(robot.joint_state().q, low, s.cartesian_step / 5)
+        assert path is not None
+        felt = b.descend(path, 0.02, "test")
+        assert felt is not None and "unexpected contact" in felt.message
+        over = tcp_pose(robot.joint_state().q)
+        over[2, 3] += 0.002
+        up = cartesian_line(robot.joint_state().q, over, s.cartesian_step / 5)
+        assert up is not None
+        assert run(timed(up, s, tcp_speed=0.02), "test") is None
+        robot.sleep(0.3)
+        start = tcp_pose(robot.joint_state().q)[:3, 3]
+        above = tcp_pose(robot.joint_state().q)
+        above[2, 3] += 0.10
+        moves.clear()
+        assert b.leave_object(above, CollisionChecker(np.zeros((0, 3)))) is None
+        assert moves == ["freeing the fingers", "rising off what the fingers met", "drawing back"]
+        moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
+        np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
+    finally:
+        robot.close()
+
+
+@pytest.mark.parametrize("lean", [0.026, -0.026], ids=["first-way-in", "first-way-out"])
+def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(lean: float):
+    """Let go on the floor, a pill bottle can spring onto one open pad and lean on it (0.4 N,
+    well under GRIPPER_HOLD_FORCE) with its cap's lip over the pad: the hand, risen
+    straight up, takes it 10 cm up. An open
+    hand whose pads still feel something is lowered 5 mm, which here leaves the pads
+    feeling nothing while the bottle still leans over one, and then eased sideways along
+    its closing axis. The gripper feels only the pads' sum, not which pad, so the first
+    way it tries may push into the bottle: the guard stops it there, and the other way
+    frees the pad."""
+    robot = SimRobot(load_scene(str(DATA / "pill_lean.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        referee = Referee(robot)
+        bottle = referee.position("pill_bottle_1")
+        b = Behaviours(robot)
+        s = b.settings.motion
+        # Level from the side, the pads' top edges 2 mm under the cap's lip (7 cm up); the
+        # wrist stays in front of the table's edge, 6 cm before the bottle's middle.
+        z = bottle[2] + 0.057
+        top = np.mgrid[1.65:2.25:0.02, -0.65:0.35:0.02].reshape(2, -1).T
+        table = CollisionChecker(np.c_[top, np.full(len(top), bottle[2])], margin=0.0)
+        out_front = side_pose(bottle[0] - 0.10, bottle[1], z)
+        q = next(q for q in ik_tcp(out_front, dims.UR5_READY_Q) if table.clearance_ok(q)[0])
+        assert b.go_to(q, table, "test").ok
+        for y, speed in ((bottle[1], 0.03), (bottle[1] + lean, 0.01)):  # about it, then aside
+            path = cartesian_line(robot.joint_state().q, side_pose(bottle[0], y, z))
+            assert path is not None and b.run(timed(path, s, tcp_speed=speed), "test") is None
+        robot.sleep(0.5)
+        assert BEHAVIOUR.pads_clear < robot.gripper_state().force < dims.GRIPPER_HOLD_FORCE
+        start = tcp_pose(robot.joint_state().q)
+        above = start.copy()
+        above[2, 3] += 0.10
+        # A post behind the hand: no way back, so it rises straight up, as on the floor.
+        post = np.array(
+            [[bottle[0] - 0.07, start[1, 3], h] for h in np.arange(z - 0.05, z + 0.3, 0.01)]
+        )
+        moves = recorded_moves(b)
+        assert b.leave_object(above, CollisionChecker(post)) is None
+        # The side pose's closing axis is +y, the first way tried. Moved +y, the hand's -y pad
+        # presses the bottle, and +y takes that pad into it; moved -y, +y frees the +y pad.
+        eased = 2 if lean > 0 else 1
+        assert moves == ["freeing the fingers"] + ["easing the pads off"] * eased + [
+            "rising from the object"
+        ]
+        robot.sleep(1.0)
+        assert robot.gripper_state().force <= BEHAVIOUR.pads_clear
+        assert abs(referee.position("pill_bottle_1")[2] - bottle[2]) < 0.003, "left on the table"
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        shift = BEHAVIOUR.leave_shift
+        np.testing.assert_allclose(end[1], start[1, 3] - np.sign(lean) * shift, atol=0.003)
+        assert end[2] > z + 0.09, "and the hand rose"
+    finally:
+        robot.close()
+
+
+def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leaves():
+    """Opened, a finger can still press a mug it dragged by its handle (8.9 N), and drawn
+    straight up, lift the mug 9 cm by the handle's top bar; lowered first, it comes
+    free. An open hand whose pads still press something is lowered first from any
+    approach, guarded over what the pads already bear, then eased sideways off it. Here
+    the open hand straddles a rail from above, one pad pressed against it."""
+    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        b = Behaviours(robot)
+        moves = recorded_moves(b)
+        free = CollisionChecker(np.zeros((0, 3)))
+        hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
+        s = b.settings.motion
+        straddling = top_down(1.60, -0.30, RAIL_TOP - 0.01)
+        down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
+        assert down is not None and b.run(timed(down, s, tcp_speed=0.05), "test") is None
+        # Sideways, 12.5 mm past where a pad meets the rail: the finger gives, and presses
+        # it (less and less as it goes on giving: read at once).
+        pressed = top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
+        across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
+        assert across is not None and b.run(timed(across, s, tcp_speed=0.02), "test") is None
+        assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+        start = tcp_pose(robot.joint_state().q)
+        above = start.copy()
+        above[2, 3] += 0.10
+        moves.clear()
+        assert b.leave_object(above, free) is None
+        assert moves[0] == "freeing the fingers"
+        assert moves[-1] == "drawing back"
+        # Lowered `leave_drop` (or less, where the guard stopped it), eased sideways off the
+        # rail (the -y pad pressed the rail's -y face from outside: away is -y), then drawn
+        # straight up.
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        assert "easing the pads off" in moves
+        np.testing.assert_allclose(end[0], above[0, 3], atol=0.005)
+        shift, drop = BEHAVIOUR.leave_shift, BEHAVIOUR.leave_drop
+        assert above[1, 3] - shift - 0.003 < end[1] < above[1, 3] - shift / 2
+        assert above[2, 3] - drop - 0.003 < end[2] < above[2, 3] + 0.003
+    finally:
+        robot.close()
