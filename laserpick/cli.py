@@ -37,6 +37,16 @@ import sys
 import uuid
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import viser
+    from fastapi import FastAPI
+
+    from laserpick.console.operator_console import OperatorConsole
+    from laserpick.console.viewer import SceneViewer
+    from laserpick.server.journal import Journal
+    from laserpick.server.session import Session
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
@@ -285,22 +295,136 @@ def default_journal() -> Path:
     return Path(root) / "laserpick" / "journal.sqlite3"
 
 
-def cmd_serve(args: argparse.Namespace) -> int:
-    """Run the simulation, the API and the 3D console until SIGINT or SIGTERM."""
-    loopback = is_loopback(args.host)
+def _serve_usage_problem(args: argparse.Namespace, loopback: bool) -> str | None:
+    """Why `serve` refuses `args` (a non-loopback host without a password, a bad port), or
+    None."""
     if not loopback and not os.environ.get(PASSWORD_ENV):
-        _say(
+        return (
             f"refusing to bind {args.host!r}: it is not a loopback address, and anyone who "
             f"reaches it could watch or command the robot. Set {PASSWORD_ENV} to allow it, "
-            "or use --host 127.0.0.1.",
-            err=True,
+            "or use --host 127.0.0.1."
         )
-        return EXIT_USAGE
     for name in ("port", "viser_port"):
         value = getattr(args, name)
         if not 0 <= value <= 65535:
-            _say(f"--{name.replace('_', '-')} {value} is not a TCP port", err=True)
-            return EXIT_USAGE
+            return f"--{name.replace('_', '-')} {value} is not a TCP port"
+    return None
+
+
+def _open_journal(path: Path | None) -> Journal | None:
+    """The session's journal at `path` (default `default_journal()`), or None (said why)."""
+    from laserpick.server.journal import Journal, JournalError
+
+    try:
+        return Journal(path or default_journal(), session=uuid.uuid4().hex)
+    except (JournalError, OSError) as exc:
+        _say(f"cannot open the journal: {exc}", err=True)
+        return None
+
+
+class _ViewServer:
+    """The viser server, with the 3D scene view and the operator console drawn on it."""
+
+    def __init__(self) -> None:
+        self.server: viser.ViserServer | None = None
+        self.viewer: SceneViewer | None = None
+        self.console: OperatorConsole | None = None
+
+    def start(self, args: argparse.Namespace, session: Session, loopback: bool) -> int:
+        """Start the server on --viser-port, the view and the console (with controls only on
+        loopback); the port it took."""
+        import viser
+
+        from laserpick.console.operator_console import OperatorConsole
+        from laserpick.console.viewer import SceneViewer
+
+        self.server = viser.ViserServer(
+            host=args.host, port=args.viser_port, label="laserpick", verbose=False
+        )
+        viewer = self.viewer = SceneViewer(
+            session.robot.sim,  # type: ignore[attr-defined]
+            self.server,
+            rate_hz=args.viewer_rate,
+            controls=False,
+            lite=args.lite_view,
+        )
+        viewer.start()
+        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))  # type: ignore[attr-defined]
+        self.console = OperatorConsole(session, self.server, controls=loopback)
+        self.console.start()
+        port = self.server.get_port()
+        if port != args.viser_port and args.viser_port != 0:
+            _say(f"port {args.viser_port} was busy; the 3D view took {port}", err=True)
+        if not loopback:
+            _say(
+                "the 3D view's port has no authentication of its own: it is view-only here; "
+                "put it behind the TLS proxy (deploy/)",
+                err=True,
+            )
+        return port
+
+    def stop_drawing(self) -> None:
+        """Stop the console and the view (before the session closes)."""
+        if self.console is not None:
+            self.console.stop()
+        if self.viewer is not None:
+            self.viewer.stop()
+
+    def stop_server(self) -> None:
+        if self.server is not None:
+            self.server.stop()
+
+
+def _api_app(session: Session, viser_port: int, viser_url: str | None) -> FastAPI:
+    """The API around `session`, with the simulator's routes when its robot is simulated."""
+    from laserpick.robot.sim.robot import SimRobot
+    from laserpick.server.app import create_app
+
+    app = create_app(session, viser_port=viser_port, viser_url=viser_url)
+    if isinstance(session.robot, SimRobot):
+        from laserpick.server.routers.simulation import include_simulator
+
+        include_simulator(app)
+    return app
+
+
+def _run_api(app: FastAPI, host: str, port: int, viser_port: int) -> bool:
+    """Serve `app` with uvicorn until SIGINT or SIGTERM, saying the URLs once it is up;
+    whether it started."""
+    import uvicorn
+
+    config = uvicorn.Config(app, host=host, port=port, log_level="warning", ws="websockets-sansio")
+    api = uvicorn.Server(config)
+
+    async def serve() -> None:
+        task = asyncio.create_task(api.serve())
+        while not api.started and not task.done():
+            await asyncio.sleep(0.05)
+        if api.started:
+            bound = api.servers[0].sockets[0].getsockname()[1]
+            _say(f"console at http://{_url_host(host)}:{bound}/")
+            _say(f"3D view at http://{_url_host(host)}:{viser_port}/")
+        await task
+
+    # uvicorn turns SIGINT and SIGTERM into a graceful shutdown, then raises the signal
+    # again with the handlers it found; with these no-op handlers in place, that second
+    # signal ends nothing, and the caller's cleanup (halt, journal) still runs.
+    previous = {sig: signal.signal(sig, lambda *_: None) for sig in STOP_SIGNALS}
+    try:
+        asyncio.run(serve())
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return api.started
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    """Run the simulation, the API and the 3D console until SIGINT or SIGTERM."""
+    loopback = is_loopback(args.host)
+    problem = _serve_usage_problem(args, loopback)
+    if problem is not None:
+        _say(problem, err=True)
+        return EXIT_USAGE
 
     # Heavy imports only once the arguments are sane: `laserpick --help` stays fast.
     from laserpick.robot.sim.scenes import load_scene
@@ -310,91 +434,25 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except Exception as exc:
         _say(f"cannot load scene {args.scene!r}: {exc}", err=True)
         return EXIT_USAGE
-
-    from laserpick.server.journal import Journal, JournalError
-
-    try:
-        journal = Journal(args.journal or default_journal(), session=uuid.uuid4().hex)
-    except (JournalError, OSError) as exc:
-        _say(f"cannot open the journal: {exc}", err=True)
+    journal = _open_journal(args.journal)
+    if journal is None:
         return EXIT_USAGE
 
-    import uvicorn
-    import viser
-
-    from laserpick.console.operator_console import OperatorConsole
-    from laserpick.console.viewer import SceneViewer
     from laserpick.robot.sim.robot import SimRobot
-    from laserpick.server.app import create_app
     from laserpick.server.session import Session
 
     session = Session(SimRobot(scene, realtime=True), journal=journal)
-    server: viser.ViserServer | None = None
-    viewer: SceneViewer | None = None
-    console: OperatorConsole | None = None
+    views = _ViewServer()
     try:
-        server = viser.ViserServer(
-            host=args.host, port=args.viser_port, label="laserpick", verbose=False
-        )
-        viewer = SceneViewer(
-            session.robot.sim,
-            server,
-            rate_hz=args.viewer_rate,
-            controls=False,
-            lite=args.lite_view,
-        )
-        viewer.start()
-        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))
-        console = OperatorConsole(session, server, controls=loopback)
-        console.start()
-        viser_port = server.get_port()
-        if viser_port != args.viser_port and args.viser_port != 0:
-            _say(f"port {args.viser_port} was busy; the 3D view took {viser_port}", err=True)
-        if not loopback:
-            _say(
-                "the 3D view's port has no authentication of its own: it is view-only here; "
-                "put it behind the TLS proxy (deploy/)",
-                err=True,
-            )
-        app = create_app(session, viser_port=viser_port, viser_url=args.viser_url)
-        config = uvicorn.Config(
-            app,
-            host=args.host,
-            port=args.port,
-            log_level="warning",
-            ws="websockets-sansio",
-        )
-        api = uvicorn.Server(config)
-
-        async def serve() -> None:
-            task = asyncio.create_task(api.serve())
-            while not api.started and not task.done():
-                await asyncio.sleep(0.05)
-            if api.started:
-                port = api.servers[0].sockets[0].getsockname()[1]
-                _say(f"console at http://{_url_host(args.host)}:{port}/")
-                _say(f"3D view at http://{_url_host(args.host)}:{viser_port}/")
-            await task
-
-        # uvicorn turns SIGINT and SIGTERM into a graceful shutdown, then raises the signal
-        # again with the handlers it found; with these no-op handlers in place, that second
-        # signal ends nothing, and the cleanup below (halt, journal) still runs.
-        previous = {sig: signal.signal(sig, lambda *_: None) for sig in STOP_SIGNALS}
-        try:
-            asyncio.run(serve())
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
+        viser_port = views.start(args, session, loopback)
+        app = _api_app(session, viser_port, args.viser_url)
+        started = _run_api(app, args.host, args.port, viser_port)
         _say("shutting down")
-        return 0 if api.started else 1
+        return 0 if started else 1
     finally:
-        if console is not None:
-            console.stop()
-        if viewer is not None:
-            viewer.stop()
+        views.stop_drawing()
         session.close()
-        if server is not None:
-            server.stop()
+        views.stop_server()
         journal.close()
 
 
