@@ -58,7 +58,7 @@ class Findings:
 
 class SessionCore:
     """The state the session's parts share, and the helpers they all use. Set up by
-    `Session.__init__`; `attach` (re)starts the task on a robot."""
+    `Session.__init__`, which also (re)starts the task on a robot."""
 
     settings: Settings
     journal: Journal | None
