@@ -49,7 +49,7 @@ def main() -> None:
         totals = {}
         for label, reach in (("cropped", cropped), ("all kept", lambda p: np.ones(len(p), bool))):
             recall.within_reach = reach
-            print(f"{label}: {len(session._recalled().points)} recalled points")
+            print(f"{label}: {len(session.recalled().points)} recalled points")
             totals[label] = 0.0
             for p in truth.scene.placements:
                 aim = truth.visible_top(truth_cloud, p.instance)
@@ -64,7 +64,7 @@ def main() -> None:
                         dims.UR5_READY_Q,
                         q_capture=q,
                         rng=np.random.default_rng(r),
-                        recalled=session._recalled(),
+                        recalled=session.recalled(),
                     )
                     took = time.perf_counter() - t0
                     if isinstance(found, GraspSet) and (best is None or took < best[0]):

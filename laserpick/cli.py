@@ -46,9 +46,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import viser
     from fastapi import FastAPI
 
+    from laserpick.console.operator_console import OperatorConsole
+    from laserpick.console.viewer import SceneViewer
     from laserpick.server.journal import Journal
+    from laserpick.server.session import Session
 
 PASSWORD_ENV = "LASERPICK_OPERATOR_PASSWORD"
 EXIT_USAGE = 2
@@ -324,22 +328,95 @@ def default_journal() -> Path:
     return Path(root) / "laserpick" / "journal.sqlite3"
 
 
-def cmd_serve(args: argparse.Namespace) -> int:
-    """Run the simulation, the API and the 3D console until SIGINT or SIGTERM."""
-    loopback = is_loopback(args.host)
+def _serve_usage_problem(args: argparse.Namespace, loopback: bool) -> str | None:
+    """Why `serve` refuses `args` (a non-loopback host without a password, a bad port), or
+    None."""
     if not loopback and not os.environ.get(PASSWORD_ENV):
-        _say(
+        return (
             f"refusing to bind {args.host!r}: it is not a loopback address, and anyone who "
             f"reaches it could watch or command the robot. Set {PASSWORD_ENV} to allow it, "
-            "or use --host 127.0.0.1.",
-            err=True,
+            "or use --host 127.0.0.1."
         )
-        return EXIT_USAGE
     for name in ("port", "viser_port"):
         value = getattr(args, name)
         if not 0 <= value <= 65535:
-            _say(f"--{name.replace('_', '-')} {value} is not a TCP port", err=True)
-            return EXIT_USAGE
+            return f"--{name.replace('_', '-')} {value} is not a TCP port"
+    return None
+
+
+class _ViewServer:
+    """The viser server, with the 3D scene view and the operator console drawn on it."""
+
+    def __init__(self) -> None:
+        self.server: viser.ViserServer | None = None
+        self.viewer: SceneViewer | None = None
+        self.console: OperatorConsole | None = None
+
+    def start(self, args: argparse.Namespace, session: Session, loopback: bool) -> int:
+        """Start the server on --viser-port, the view and the console (with controls only on
+        loopback); the port it took."""
+        import viser
+
+        from laserpick.console.operator_console import OperatorConsole
+        from laserpick.console.viewer import SceneViewer
+
+        self.server = viser.ViserServer(
+            host=args.host, port=args.viser_port, label="laserpick", verbose=False
+        )
+        viewer = self.viewer = SceneViewer(
+            session.robot.sim,  # type: ignore[attr-defined]
+            self.server,
+            rate_hz=args.viewer_rate,
+            controls=False,
+            lite=args.lite_view,
+        )
+        viewer.start()
+        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))  # type: ignore[attr-defined]
+        self.console = OperatorConsole(session, self.server, controls=loopback)
+        self.console.start()
+        port = self.server.get_port()
+        if port != args.viser_port and args.viser_port != 0:
+            _say(f"port {args.viser_port} was busy; the 3D view took {port}", err=True)
+        if not loopback:
+            _say(
+                "the 3D view's port has no authentication of its own: it is view-only here; "
+                "put it behind the TLS proxy (deploy/)",
+                err=True,
+            )
+        return port
+
+    def stop_drawing(self) -> None:
+        """Stop the console and the view (before the session closes)."""
+        if self.console is not None:
+            self.console.stop()
+        if self.viewer is not None:
+            self.viewer.stop()
+
+    def stop_server(self) -> None:
+        if self.server is not None:
+            self.server.stop()
+
+
+def _api_app(session: Session, viser_port: int, viser_url: str | None) -> FastAPI:
+    """The API around `session`, with the simulator's routes when its robot is simulated."""
+    from laserpick.robot.sim.robot import SimRobot
+    from laserpick.server.app import create_app
+
+    app = create_app(session, viser_port=viser_port, viser_url=viser_url)
+    if isinstance(session.robot, SimRobot):
+        from laserpick.server.routers.simulation import include_simulator
+
+        include_simulator(app)
+    return app
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    """Run the simulation, the API and the 3D console until SIGINT or SIGTERM."""
+    loopback = is_loopback(args.host)
+    problem = _serve_usage_problem(args, loopback)
+    if problem is not None:
+        _say(problem, err=True)
+        return EXIT_USAGE
 
     if args.recorded is not None:
         return serve_recording(args)
@@ -352,57 +429,23 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except Exception as exc:
         _say(f"cannot load scene {args.scene!r}: {exc}", err=True)
         return EXIT_USAGE
-
     journal = open_journal(args.journal)
     if journal is None:
         return EXIT_USAGE
 
-    import viser
-
-    from laserpick.console.operator_console import OperatorConsole
-    from laserpick.console.viewer import SceneViewer
     from laserpick.robot.sim.robot import SimRobot
-    from laserpick.server.app import create_app
     from laserpick.server.session import Session
 
     session = Session(SimRobot(scene, realtime=True), journal=journal)
-    server: viser.ViserServer | None = None
-    viewer: SceneViewer | None = None
-    console: OperatorConsole | None = None
+    views = _ViewServer()
     try:
-        server = viser.ViserServer(
-            host=args.host, port=args.viser_port, label="laserpick", verbose=False
-        )
-        viewer = SceneViewer(
-            session.robot.sim,
-            server,
-            rate_hz=args.viewer_rate,
-            controls=False,
-            lite=args.lite_view,
-        )
-        viewer.start()
-        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))
-        console = OperatorConsole(session, server, controls=loopback)
-        console.start()
-        viser_port = server.get_port()
-        if viser_port != args.viser_port and args.viser_port != 0:
-            _say(f"port {args.viser_port} was busy; the 3D view took {viser_port}", err=True)
-        if not loopback:
-            _say(
-                "the 3D view's port has no authentication of its own: it is view-only here; "
-                "put it behind the TLS proxy (deploy/)",
-                err=True,
-            )
-        app = create_app(session, viser_port=viser_port, viser_url=args.viser_url)
+        viser_port = views.start(args, session, loopback)
+        app = _api_app(session, viser_port, args.viser_url)
         return run_api(app, args.host, args.port, viser_port)
     finally:
-        if console is not None:
-            console.stop()
-        if viewer is not None:
-            viewer.stop()
+        views.stop_drawing()
         session.close()
-        if server is not None:
-            server.stop()
+        views.stop_server()
         journal.close()
 
 

@@ -208,7 +208,7 @@ def test_the_blind_spot_beside_the_parked_scooter_was_seen_on_the_way_in():
         kept = len(session.views)
         assert kept == session.settings.perception.recall_views
         frames = robot.capture()
-        recalled = session._recalled()
+        recalled = session.recalled()
         assert len(recalled.frames) == 5 * kept
         blind_spot = np.array([[1.40, -0.75, 0.90], [1.30, -0.55, 0.80]])
         assert not seen_free(blind_spot, frames, TOL).any()
@@ -232,7 +232,7 @@ def test_the_blind_spot_beside_the_parked_scooter_was_seen_on_the_way_in():
         # ready, the arm finds the place it folds into free in what the stow plans around.
         assert not self_filter(fuse(frames).points, q_home).all()
         assert session.behaviours.go_ready().ok
-        around = session._surroundings(session._try_look())
+        around = session.surroundings(session.capture_or_none())
         assert around is not None and around.clearance_ok(q_home)[0]
         # With the arm away from its stowed pose, driving keeps no view.
         session.views.clear()
@@ -268,7 +268,7 @@ def test_a_picked_object_is_forgotten_where_it_stood_and_no_view_is_kept_holding
         mug = referee.object_points("mug_1")
         # Above the table top (0.46 m): the table under the mug stays.
         above = (mug[:, 2].min() + 0.01, np.inf)
-        d, _ = cKDTree(mug).query(_between(session._recalled().points, *above))
+        d, _ = cKDTree(mug).query(_between(session.recalled().points, *above))
         assert (d < 0.01).sum() > 20  # the views saw the mug where it stands
         session.set_mode(actor, mode="pick_and_place")
         centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
@@ -279,7 +279,7 @@ def test_a_picked_object_is_forgotten_where_it_stood_and_no_view_is_kept_holding
         session.execute(actor)
         _settle(session)
         assert session.state == TaskState.AWAITING_PLACE, session.message
-        d, _ = cKDTree(mug).query(_between(session._recalled().points, *above))
+        d, _ = cKDTree(mug).query(_between(session.recalled().points, *above))
         # No ghost: nothing where the mug's surface was. A stray pixel of table and handle
         # mixed (1.6 cm off the mug, 1.2 cm over the table) lies outside CARRIED_PADDING of
         # what was seen of it, or inside, as the scooter's odometry ends the pick a fraction

@@ -23,9 +23,11 @@ from websockets.sync.client import connect
 
 from laserpick.bench.operator import parking_pose
 from laserpick.client import API, ApiError, Client
+from laserpick.description import dims
 from laserpick.robot.sim.scenes import load_scene, scene_config
 from laserpick.server.journal import Journal
 from laserpick.server.wire import decode_cloud
+from laserpick.settings import get_settings
 from laserpick.transforms import invert, planar_pose
 
 pytestmark = pytest.mark.timeout(420)
@@ -301,6 +303,25 @@ def test_heartbeats_are_acknowledged_and_strangers_refused(server: ServeProcess)
             ws.close()
     assert replies[0]["type"] == "heartbeat_ack" and replies[0]["echo"] == 12.5
     assert replies[1]["type"] == "error" and "lease" in replies[1]["detail"]
+
+
+def test_health_names_the_scene_and_the_limits_clients_keep_to(server: ServeProcess) -> None:
+    """Clients read the input limits from `/health` rather than repeating them."""
+    health = requests.get(f"{server.url}{API}/health", timeout=10).json()
+    limits = get_settings().server
+    assert health["status"] == "ok" and health["scene"] == "isolation"
+    assert health["max_nudge"] == limits.max_nudge and health["watchdog_s"] == limits.watchdog_s
+    assert health["max_drive_duration"] == 0.5
+    assert health["max_speed"] == dims.BASE_V_MAX and health["max_turn_rate"] == dims.BASE_W_MAX
+    too_far = {"dyaw": health["max_nudge"] * 1.01}
+    with Client(server.url, name="limits") as c:
+        r = requests.post(
+            f"{server.url}{API}/laser/nudge",
+            json=too_far,
+            headers={"Authorization": f"Bearer {c.token}"},
+            timeout=10,
+        )
+    assert r.status_code == 422
 
 
 def test_a_second_client_cannot_take_control(server: ServeProcess) -> None:

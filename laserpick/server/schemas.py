@@ -8,7 +8,7 @@ are SI (m, rad, s); points are in `base` unless `frame` says `world`.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -16,6 +16,11 @@ from laserpick.description import dims
 from laserpick.settings import get_settings
 
 _server = get_settings().server
+
+#: Largest laser nudge per command (rad): `ServerSettings.max_nudge`, as this process read it.
+MAX_NUDGE = _server.max_nudge
+#: Longest a drive command lasts (s): it is a dead-man, sent again to keep going.
+MAX_DRIVE_DURATION = 0.5
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-50.0, le=50.0)]
@@ -86,10 +91,8 @@ class AimResult(BaseModel):
 class NudgeRequest(_Body):
     """Turn the laser by small steps (rad): + yaw turns left, + pitch up."""
 
-    dyaw: Annotated[float, Field(allow_inf_nan=False, ge=-_server.max_nudge, le=_server.max_nudge)]
-    dpitch: Annotated[
-        float, Field(allow_inf_nan=False, ge=-_server.max_nudge, le=_server.max_nudge)
-    ] = 0.0
+    dyaw: Annotated[float, Field(allow_inf_nan=False, ge=-MAX_NUDGE, le=MAX_NUDGE)]
+    dpitch: Annotated[float, Field(allow_inf_nan=False, ge=-MAX_NUDGE, le=MAX_NUDGE)] = 0.0
 
 
 class StepRequest(_Body):
@@ -113,7 +116,9 @@ class DriveRequest(_Body):
 
     v: Annotated[float, Field(allow_inf_nan=False, ge=-dims.BASE_V_MAX, le=dims.BASE_V_MAX)]
     w: Annotated[float, Field(allow_inf_nan=False, ge=-dims.BASE_W_MAX, le=dims.BASE_W_MAX)] = 0.0
-    duration: Annotated[float, Field(allow_inf_nan=False, gt=0.0, le=0.5)] = 0.5
+    duration: Annotated[float, Field(allow_inf_nan=False, gt=0.0, le=MAX_DRIVE_DURATION)] = (
+        MAX_DRIVE_DURATION
+    )
     seq: int | None = Field(
         None,
         ge=0,
@@ -276,7 +281,12 @@ class Health(BaseModel):
         " page's host (behind the TLS proxy: /viser/)."
     )
     rtf: float
-
-
-def status_model(data: dict[str, Any]) -> Status:
-    return Status.model_validate(data)
+    max_nudge: float = Field(description="Largest laser nudge per command (rad).")
+    max_drive_duration: float = Field(
+        description="Longest a drive command lasts (s): send it again sooner to keep going."
+    )
+    max_speed: float = Field(description="Largest forward or backward drive speed (m/s).")
+    max_turn_rate: float = Field(description="Largest drive turn rate (rad/s).")
+    watchdog_s: float = Field(
+        description="Motion halts when the controller is silent this long (s)."
+    )

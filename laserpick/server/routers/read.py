@@ -1,0 +1,90 @@
+"""Reads, which need no token: health (with the limits clients keep to), the session's state,
+the projector image, the fused cloud and the journal."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from fastapi import APIRouter, HTTPException, Query
+from fastapi.responses import PlainTextResponse, Response
+
+from laserpick import __version__
+from laserpick.description import dims
+from laserpick.pipeline.cloud import voxel_downsample
+from laserpick.server import schemas as S
+from laserpick.server.routers.dependencies import API, SessionDep, SettingsDep
+from laserpick.server.wire import CLOUD_FORMAT, encode_cloud, encode_png
+
+__all__ = ["router"]
+
+router = APIRouter(prefix=API, tags=["read"])
+
+
+@router.get("/health", response_model=S.Health)
+def health(session: SessionDep, settings: SettingsDep) -> S.Health:
+    return S.Health(
+        status="ok",
+        version=__version__,
+        scene=settings.scene_name(session),
+        viser_port=settings.viser_port,
+        viser_url=settings.viser_url,
+        rtf=round(session.robot.state().rtf, 3),
+        max_nudge=S.MAX_NUDGE,
+        max_drive_duration=S.MAX_DRIVE_DURATION,
+        max_speed=dims.BASE_V_MAX,
+        max_turn_rate=dims.BASE_W_MAX,
+        watchdog_s=session.settings.server.watchdog_s,
+    )
+
+
+@router.get("/state", response_model=S.Status)
+def state(session: SessionDep) -> S.Status:
+    return session.status_model()
+
+
+@router.get(
+    "/projector.png",
+    response_class=Response,
+    responses={200: {"content": {"image/png": {}}, "description": "The projector image."}},
+)
+def projector(session: SessionDep) -> Response:
+    image = session.projection
+    if image is None:  # nothing lit: a black image of the projector's size
+        image = np.zeros((session.projector.height, session.projector.width), np.uint8)
+    return Response(encode_png(image), media_type="image/png")
+
+
+@router.get(
+    "/cloud",
+    response_class=Response,
+    responses={
+        200: {
+            "content": {"application/octet-stream": {}},
+            "description": f"The fused cloud, voxel-thinned: {CLOUD_FORMAT}.",
+        }
+    },
+)
+def cloud(
+    session: SessionDep,
+    voxel: Annotated[float | None, Query(gt=0.002, le=0.2, allow_inf_nan=False)] = None,
+) -> Response:
+    thinned = voxel_downsample(session.cloud(), voxel or session.settings.server.cloud_voxel)
+    return Response(encode_cloud(thinned.points), media_type="application/octet-stream")
+
+
+@router.get("/journal", responses={200: {"content": {"application/json": {}, "text/csv": {}}}})
+def journal(
+    session: SessionDep,
+    format: Literal["json", "csv"] = "json",
+    since_id: Annotated[int, Query(ge=0, le=2**62)] = 0,
+    limit: Annotated[int, Query(ge=1, le=100_000)] = 10_000,
+) -> Response:
+    j = session.journal
+    if j is None:
+        raise HTTPException(404, "this server keeps no journal")
+    if format == "csv":
+        text = j.export_csv(since_id=since_id, limit=limit)
+        return PlainTextResponse(text, media_type="text/csv")
+    text = j.export_json(since_id=since_id, limit=limit)
+    return Response(text, media_type="application/json")
