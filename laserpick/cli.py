@@ -404,9 +404,10 @@ def _api_app(session: Session, viser_port: int, viser_url: str | None) -> FastAP
 
     app = create_app(session, viser_port=viser_port, viser_url=viser_url)
     if isinstance(session.robot, SimRobot):
+        from laserpick.robot.sim.service import SimulatorService
         from laserpick.server.routers.simulation import include_simulator
 
-        include_simulator(app)
+        include_simulator(app, SimulatorService(session.settings))
     return app
 
 

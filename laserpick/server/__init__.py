@@ -3,8 +3,8 @@ drives), its web API (`app` with one router a resource in `routers`, the bodies 
 and `wire`, refusals in `errors`, the websocket fan-out in `events`), the control lease
 (`lease`) and the session journal (`journal`).
 
-It works on any `laserpick.robot.interface.Robot`; only `routers.simulation`, which the CLI
-includes for a simulated robot, imports the simulator. Nothing here imports the bench.
+It works on any `laserpick.robot.interface.Robot` and imports neither the simulator nor the
+bench; `routers.simulation` serves what a simulator offers when the CLI hands one in.
 Submodules are imported where used, so that reading the journal needs no web framework.
 """
 

@@ -11,7 +11,7 @@ size limit; 422 for invalid input, naming the field. Handlers that touch the rob
 
 The routes live in `routers/`, one module a resource, sharing `routers/dependencies.py`. A
 simulated robot's routes (`/sim/objects`, `POST /scene`) are added by
-`routers.simulation.include_simulator`, which the CLI calls only for a `SimRobot`.
+`routers.simulation.include_simulator`, which the CLI calls only for a simulated robot.
 """
 
 from __future__ import annotations
