@@ -204,7 +204,7 @@ def server_only(rounds: int) -> int:
 
     import viser
 
-    from laserpick.bench.operator import Referee
+    from laserpick.bench.referee import Referee
     from laserpick.console.operator_console import OperatorConsole
     from laserpick.robot.sim.robot import SimRobot
     from laserpick.robot.sim.scenes import load_scene

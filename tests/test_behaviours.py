@@ -31,8 +31,8 @@ from laserpick.behaviours import (
     drop_candidates,
     turned_hand_xy,
 )
-from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose

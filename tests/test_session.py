@@ -10,7 +10,7 @@ import numpy as np
 from driving import drive_straight
 
 from laserpick.behaviours import HOLD_TURNS, PAST_THE_OPENING, Held, Outcome
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasping import GraspSet
