@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.parking import FLOOR_TURNS, PARK_FLOOR_REACH, parking_pose
-from laserpick.bench.picking import Attempt
 from laserpick.bench.protocols.retries import IN_VIEW_ACROSS, RETRY_BACK, next_try
 from laserpick.bench.route_planning import (
     DRIVE_MARGIN,

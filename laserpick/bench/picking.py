@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from laserpick.bench.attempts import Attempt, stage_timings
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.robot.sim.robot import SimRobot
@@ -61,41 +62,6 @@ LEVER_MAX = 0.02
 UNPLANNED_NEAR = 0.01
 #: The session's progress messages at the moment the hand lets go of the object.
 RELEASED = frozenset({"Released into the basket.", "Placed."})
-
-
-@dataclass
-class Attempt:
-    """The record of one grasp attempt on one marked object (JSON-ready through `as_dict`)."""
-
-    trial: int
-    seed: int
-    instance: str
-    model: str
-    surface: str | None
-    selection: str
-    strategy: str
-    task: int = 0  #: which task of the trial: the tries at one object share it
-    marks: int = 0  #: marks made (re-marks after a missed dot count)
-    places: int = 0  #: place marks confirmed (pick and place)
-    detected: bool = False  #: the grasp chosen (or executed) was on the marked object
-    #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)
-    grasped: bool = False
-    success: bool = False  #: the attempt's task was done (in the basket, or placed upright)
-    failure: str | None = None  #: one of FAILURE_KINDS when it did not succeed
-    message: str = ""
-    timings: dict[str, float] = field(default_factory=dict)  #: s per STAGES entry
-    #: the executed grasp's planned width and the finger gap it closed to (m): an object
-    #: held across an edge or turned in the pads closes narrower than planned
-    grip: tuple[float, float] | None = None
-    #: how far (m) the executed grasp held the object off its centre of mass (`lever`)
-    lever: float | None = None
-
-    def fail(self, kind: str, message: str) -> Attempt:
-        self.failure, self.message = kind, message
-        return self
-
-    def as_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 def trial_settings(seed: int) -> Settings:
@@ -240,7 +206,7 @@ class ScriptedOperator:
             k = len(self._events)
             s.confirm(BENCH)
             self.wait()
-            rec.timings = _stages(self._events_since(k, "job"))
+            rec.timings = stage_timings(self._events_since(k, "job"))
             if s.state == TaskState.GRASPS_READY:
                 rec.failure, rec.message = None, ""  # an earlier mark's miss is behind us
                 return True
@@ -304,7 +270,7 @@ class ScriptedOperator:
         self.wait()
         execute_sim = self._released_at(k) - t_sim
         done = self._events_since(k, "job")
-        rec.timings = _stages(done, execute_sim)  # the task's last job reports all its stages
+        rec.timings = stage_timings(done, execute_sim)  # the task's last job reports all its stages
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
@@ -413,26 +379,3 @@ class Placed:
 
     failure: Failure | None
     hit: np.ndarray | None
-
-
-def _stages(jobs: list[dict[str, Any]], execute_sim: float | None = None) -> dict[str, float]:
-    """The STAGES timings of one attempt from its session jobs' reports (the last report of
-    a task holds all its stages)."""
-    raw: dict[str, float] = {}
-    for job in jobs:
-        raw.update(job.get("timings", {}))
-    out = {
-        "acquire_cloud": raw.get("capture", 0.0) + raw.get("fuse", 0.0),
-        "detect_laser": raw.get("detect_laser"),
-        "segment": raw.get("segment"),
-        "detect_grasp": raw.get("detect"),
-        "filter": raw.get("filter"),
-        "select": raw.get("select"),
-        "plan": raw.get("plan"),
-        "execute_sim": execute_sim,
-    }
-    timings = {k: float(v) for k, v in out.items() if v is not None}
-    if "fuse" not in raw:
-        timings.pop("acquire_cloud")
-    timings["attempt_total"] = math.fsum(timings.values())
-    return timings

@@ -138,7 +138,18 @@ def _heading(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def wrap_angle(a: float) -> float:
+    """The angle `a` (rad) wrapped into [-pi, pi)."""
     return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _via_points(surfaces: Sequence[Surface | Footprint], outline: Outline) -> np.ndarray:
+    """The points (N x 2, m, `world` xy) of a VIA_SPACING grid over the surfaces and 1 m
+    about them where the user might stop on the way to turn."""
+    lo = np.min([s.xy for s in surfaces], axis=0) - 1.0
+    hi = np.max([s.xy for s in surfaces], axis=0) + 1.0
+    grid = np.mgrid[lo[0] : hi[0] : VIA_SPACING, lo[1] : hi[1] : VIA_SPACING].reshape(2, -1).T
+    # The sweeps decide; this only drops points where the scooter could not even stand.
+    return grid[clearance(surfaces, grid) >= 0.5 * (outline.y[1] - outline.y[0])]
 
 
 def plan_drive(
@@ -190,11 +201,7 @@ def plan_drive(
     approaches = [a for a in approaches if clear(straight_poses(a, goal[:2], goal[2]), at_goal)]
     if not approaches:
         return None
-    lo = np.min([s.xy for s in surfaces], axis=0) - 1.0
-    hi = np.max([s.xy for s in surfaces], axis=0) + 1.0
-    grid = np.mgrid[lo[0] : hi[0] : VIA_SPACING, lo[1] : hi[1] : VIA_SPACING].reshape(2, -1).T
-    # The sweeps decide; this only drops points where the scooter could not even stand.
-    vias = grid[clearance(surfaces, grid) >= 0.5 * (outline.y[1] - outline.y[0])]
+    vias = _via_points(surfaces, outline)
     for back in sorted({reverse_first + r for r in REVERSE_STEPS}):
         out = start[:2] - back * np.array([math.cos(start[2]), math.sin(start[2])])
         if back > 0 and not clear(straight_poses(start[:2], out, start[2]), at_start):

@@ -3,8 +3,8 @@ to each object's surface and tries until the object is in the basket (at most MA
 
 from __future__ import annotations
 
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.parking import NO_PARKING, go_to_object
-from laserpick.bench.picking import Attempt
 from laserpick.bench.protocols.retries import MAX_TRIES, next_try, still_there
 from laserpick.bench.protocols.trials import (
     Options,

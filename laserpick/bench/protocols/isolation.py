@@ -3,7 +3,7 @@ order, picked and dropped in the basket."""
 
 from __future__ import annotations
 
-from laserpick.bench.picking import Attempt
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.protocols.trials import (
     Options,
     instances,

@@ -7,7 +7,7 @@ import math
 
 import yaml
 
-from laserpick.bench.picking import Attempt
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.protocols.isolation import isolation
 from laserpick.bench.protocols.trials import Options, limit, scripted_operator
 from laserpick.robot.sim.scenes import Scene, parse_scene, scene_config

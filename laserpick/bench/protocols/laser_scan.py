@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from laserpick.bench.picking import Attempt
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.protocols.trials import (
     Options,
     instances,

@@ -13,8 +13,9 @@ import re
 import numpy as np
 import yaml
 
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.parking import NO_PARKING, go_to_object, park
-from laserpick.bench.picking import Attempt, Placed, ScriptedOperator
+from laserpick.bench.picking import Placed, ScriptedOperator
 from laserpick.bench.protocols.place_spots import aim_as_told, aims_in_sight, free_spot, room_for
 from laserpick.bench.protocols.retries import MAX_TRIES, next_try, still_there
 from laserpick.bench.protocols.trials import (

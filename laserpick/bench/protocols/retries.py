@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from laserpick.bench.picking import Attempt, ScriptedOperator
+from laserpick.bench.attempts import Attempt
+from laserpick.bench.picking import ScriptedOperator
 from laserpick.pipeline.grasping import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import Scene
 

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from laserpick.bench.picking import Attempt
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.protocols.trials import (
     Options,
     instances,

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from laserpick.bench.attempts import Attempt
 from laserpick.bench.driving import drive_to
 from laserpick.bench.parking import parking_pose
-from laserpick.bench.picking import Attempt
 from laserpick.bench.protocols.trials import Options, protocol_scene, scripted_operator
 from laserpick.robot.sim.scenes import Scene, Surface
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
+from laserpick.bench.attempts import Attempt
+from laserpick.bench.picking import ScriptedOperator, open_session
 from laserpick.robot.sim.scenes import Scene, load_scene
 from laserpick.server.session import Selection, StrategyName
 
