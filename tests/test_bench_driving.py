@@ -31,8 +31,8 @@ from laserpick.transforms import invert, planar_pose
 def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
     """From the 73 cm table to the counter, the straight way swings the scooter's front (the
     arm, 1.30 m ahead of the rear axle) through the table: the simulated scooter drives
-    through furniture and swept a can off it. The planned way keeps the whole outline clear
-    of every surface but the two it is parked at, and ends where the user parks."""
+    through furniture and sweeps objects off it. The planned way keeps the whole outline
+    clear of every surface but the two it is parked at, and ends where the user parks."""
     scene = load_scene("kitchen", seed=1)
     outline = Outline((-0.15, 1.30), (-0.68, 0.38))  # the referee's, with the arm stowed
     table, counter = scene.surface("table_73"), scene.surface("counter")
@@ -77,9 +77,9 @@ def test_the_user_parks_over_only_what_they_work_at() -> None:
 
 
 def test_a_turn_near_half_a_turn_is_planned_clear_either_way() -> None:
-    """Planned as 179.6 deg to the left at the high table, the turn went to the right from
-    where the scooter stood (a few degrees off), and link 2 met the table: a turn that
-    close to half a turn is checked all the way round; a smaller one the short way only."""
+    """A turn planned close to half a turn may go either way from where the scooter stands
+    (a few degrees off): it is checked all the way round; a smaller one the short way
+    only."""
 
     def passes(yaw0: float, yaw1: float, heading_deg: float) -> bool:
         """Whether the turn's poses come within 5 deg of the heading."""

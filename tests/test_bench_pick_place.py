@@ -37,8 +37,8 @@ from laserpick.types import Failure
 
 def test_a_lying_object_set_down_turned_about_the_vertical_still_counts_as_upright():
     """A box on its side, set down a quarter turn about the vertical (a place may turn it),
-    rests as it rested; tipped onto its end, it does not. The object's own z axis turned 90
-    degrees in both, and the first counted as tipped over."""
+    rests as it rested; tipped onto its end, it does not, though the object's own z axis
+    turned 90 degrees in both."""
     tea_box = LIBRARY["tea_box"]
     lying = quat_from_matrix(rotx(math.pi / 2))
     assert not round_about_z(tea_box)
@@ -143,9 +143,8 @@ def test_the_user_leaves_room_on_the_surface_for_what_they_hold(tmp_path: Path) 
 def test_where_the_line_of_spots_is_full_the_user_sets_down_nearest_it(tmp_path: Path) -> None:
     """Every place of a trial goes to the line 25 cm behind a surface's front edge while it
     has room. Where a row of cans fills that line, the user sets a TV remote down elsewhere
-    on the top, clear of every can and of the edges, as near the line as there is room;
-    before, they found no spot and the task was lost. An empty top still takes it on the
-    line."""
+    on the top, clear of every can and of the edges, as near the line as there is room. An
+    empty top still takes it on the line."""
     cans = "".join(
         f"  - {{name: can{i}, model: soda_can, on: t, xy: [1.55, {y:.2f}]}}\n"
         for i, y in enumerate(np.arange(-0.40, 0.41, 0.10))
@@ -183,8 +182,8 @@ def test_a_set_down_object_is_judged_by_where_it_stands(tmp_path: Path) -> None:
     """The bench judges a place by the middle of the object's footprint. A place turned about
     the vertical turns the object about its middle: a juice bottle lying on its side, turned
     30 degrees so, rests where it was set down, though its origin (the middle of its bottom,
-    at one end of it lying) moved 3 cm or more and was counted off the mark. A can standing
-    upright is judged by its origin, as before."""
+    at one end of it lying) moved 3 cm or more. A can standing upright is judged by its
+    origin."""
     scene = tmp_path / "bottle.yaml"
     scene.write_text(
         "name: bottle\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
@@ -244,8 +243,8 @@ def test_a_user_whose_place_marks_are_all_refused_takes_the_object_to_another_su
 ) -> None:
     """Held as it was picked, an object may not go down on a surface at all (a spice jar
     held from a shelf at 14 degrees would take the wrist into the floor): the robot refuses
-    each mark there and keeps it. A person then carries it to another surface, as the
-    pick-place user now does. The refusal is staged here (the first surface's marks are
+    each mark there and keeps it. A person then carries it to another surface, and so does
+    the pick-place user. The refusal is staged here (the first surface's marks are
     answered with the robot's `ik_plan` refusal, without moving); the pick, the drives and
     the place on the second surface are real."""
     scene = tmp_path / "two.yaml"

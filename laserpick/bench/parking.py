@@ -26,8 +26,9 @@ from laserpick.robot.sim.scenes import Scene, Surface
 PARK_SPOT_DEPTH = 0.25
 #: m from the rear axle to the front edge of the surface the user parks at: close to a low
 #: surface, for the arm to reach over it; farther from one above the arm's shoulder, which
-#: the upper arm must rise past before it can reach forward (at 1.30 m the 73 cm table's
-#: edge stands 16 cm before the mount, and no path led from the stowed arm to the ready pose).
+#: the upper arm must rise past before it can reach forward (at 1.30 m a 73 cm table's
+#: edge stands 16 cm before the mount, and no path leads from the stowed arm to the ready
+#: pose).
 PARK_EDGE = 1.30
 PARK_EDGE_HIGH = 1.40
 #: m from the rear axle to an object on the floor the user parks at: 15 cm ahead of the
@@ -39,14 +40,13 @@ PARK_FLOOR_REACH = 1.45
 NO_PARKING = "the user could not park in front of it"
 #: Headings (rad, from the floor's +x) the user tries, in order, to park at an object on a
 #: floor: the other objects lying there, and the furniture beside it, may block a side. In
-#: 15 deg steps: in 45 deg steps the kitchen's tissue packet, 40 cm from the counter and
-#: 36 cm from the plush toy, had no heading the user could park at and drive to (each of
-#: three pick-place trials lost it).
+#: 15 deg steps: in 45 deg steps an object 40 cm from a counter and 36 cm from another
+#: object has no heading the user can park at and drive to.
 FLOOR_TURNS = tuple(math.radians(a) for a in sorted(range(-165, 195, 15), key=abs))
 #: m across (to the arm's left) the user lets an object on a floor lie from straight before
-#: the arm, in the order tried, where no heading parks with it straight before the arm: the
-#: tissue packet between the counter, the plush toy and a bowl set down beside them had a
-#: clear way in only 10-20 cm to a side.
+#: the arm, in the order tried, where no heading parks with it straight before the arm: an
+#: object between a counter and two others may have a clear way in only 10-20 cm to a
+#: side.
 FLOOR_ACROSS = (0.0, 0.1, -0.1, 0.2, -0.2)
 
 

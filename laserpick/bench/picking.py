@@ -54,7 +54,7 @@ DOT_ON_SPOT = 0.03
 JOB_TIMEOUT = 600.0
 #: The farthest (m) a user choosing by hand lets a grasp hold an object off its balance: an
 #: object held farther from its centre of mass, across the line between the fingers, swings
-#: about that line in the pads (a TV remote held near one end was set down on its side).
+#: about that line in the pads (a TV remote held near one end turns onto its side).
 LEVER_MAX = 0.02
 #: How near (m) a cluster's best grasp must lie to one the user saw fail to plan for them to
 #: take it for the same and pass it by: half 004's cluster bound (section 7.2). Neighbouring
@@ -223,8 +223,7 @@ class ScriptedOperator:
         LEVER_MAX about its centre of mass `centre`, m, `base`), as a person who sees the
         object would hold it; else to the first on `instance` at all; none such: back to the
         system's choice. Clusters where a choice failed to plan before are passed by while
-        another on `instance` is left: a cluster of one grasp that cannot be planned ended a
-        pick-place try on a shelf, and the next try chose it again."""
+        another on `instance` is left: a person does not choose again what they saw fail."""
         s = self.session
         failed = self._unplanned.get(instance, [])
         best: tuple[tuple[bool, bool], int] | None = None  # (tried, off balance), cluster
@@ -341,9 +340,8 @@ class ScriptedOperator:
                 self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
             # What the hand holds is found before it opens: in the second the gripper takes,
-            # a held object falls clear of the fingers, and was left lying where the scooter
-            # stood (seed 100's pill bottle, in front of the 73 cm table, where the user then
-            # could not park for the mug).
+            # a held object falls clear of the fingers, and would lie where the scooter
+            # stands, in the way of the next parking.
             in_hand = (
                 [n for n in self.referee.instances() if self.referee.near_hand(n)]
                 if s.behaviours.held is not None
@@ -355,8 +353,8 @@ class ScriptedOperator:
                 self.referee.take_out(name)
         if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
             # By hand, as the experimenter would: a stow from here has no cloud to plan
-            # around (the session, which had one, did not get the arm home), and one put the
-            # fingers into the 87 cm counter at 159 N, moving what stood on it.
+            # around (the session, which had one, did not get the arm home), and can drive
+            # the fingers into the furniture.
             self.referee.move_arm_home()
         s.resync(BENCH)
 

@@ -26,9 +26,9 @@ REVERSE_STEPS = (0.0, 0.4, 0.8, 1.2, 1.6)
 #: m before the parking spot where the user turns to face it and creeps in: the first that
 #: leaves room.
 APPROACH_DISTANCES = (0.8, 1.2)
-#: rad. A planned turn on the spot this close to half a turn may go either way: planned at
-#: the high table as 179.6 deg to the left, it went to the right from where the scooter
-#: stood, and link 2 met the table at up to 2,000 N.
+#: rad. A planned turn on the spot this close to half a turn may go either way: the scooter
+#: arrives a few degrees off the heading planned and turns the short way from there, which
+#: can swing the arm through a table the other way round would miss.
 TURN_EITHER_WAY = math.radians(20.0)
 
 

@@ -19,6 +19,7 @@ IN_SITU_OBJECTS = 10
 
 
 def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One in-situ trial: drive to each object and try until it is in the basket."""
     scene = protocol_scene("kitchen", seed, opt)
     out = []
     with scripted_operator(scene, trial, seed, opt) as op:

@@ -15,6 +15,7 @@ from laserpick.bench.protocols.trials import (
 
 
 def isolation(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One isolation trial: every object of the scene, in a random order, picked and dropped."""
     scene = protocol_scene("isolation", seed, opt)
     with scripted_operator(scene, trial, seed, opt) as op:
         order = limit(shuffled(op, instances(scene)), opt)

@@ -50,6 +50,7 @@ def jeeves_scene(model: str, location: str, back: float = JEEVES_BACK) -> Scene:
 
 
 def jeeves(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One jeeves trial: the trial's model on each of the six table locations."""
     if opt.scene:
         return isolation(trial, seed, opt)
     model = JEEVES_MODELS[trial % len(JEEVES_MODELS)]

@@ -42,6 +42,7 @@ def scan_points(captured: Captured, instance: str, step: float = SCAN_STEP) -> n
 
 
 def laser_scan(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One laser-scan trial: one attempt per aim point of each object, put back after each."""
     scene = protocol_scene("isolation", seed, opt)
     out = []
     with scripted_operator(scene, trial, seed, opt) as op:
@@ -52,8 +53,8 @@ def laser_scan(trial: int, seed: int, opt: Options) -> list[Attempt]:
             home = op.referee.free_joint(name)
             for point in scan_points(captured, name):
                 # The points are fixed on the object, in `world`: the arm's pushes turn the
-                # parked scooter a little with each pick (2.4 degrees over 40 attempts, which
-                # moved later points 6 cm off a TV remote).
+                # parked scooter a little with each pick (2.4 degrees over 40 attempts, 6 cm
+                # at a TV remote).
                 aim = op.referee.to_base((T_world_base @ np.append(point, 1.0))[:3])
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 out.append(op.pick_and_drop(rec, aim=aim))

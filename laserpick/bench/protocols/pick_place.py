@@ -43,6 +43,7 @@ PLACE_TOLERANCE = 0.03
 
 
 def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One pick-place trial: every object picked and set down on another surface."""
     rng = np.random.default_rng(seed)
     scene = protocol_scene("", seed, opt) if opt.scene else coin_flip_kitchen(rng)
     out = []
@@ -88,9 +89,9 @@ _OBJECT_PATH = re.compile(r"objects\[(\d+)\]")
 
 def _up_in_object(quat: np.ndarray) -> np.ndarray:
     """The world's up in the frame of an object at orientation `quat` (w, x, y, z): it stays
-    put when the object turns about the vertical. (The object's own z axis does not: a can
-    lying on its side and set down turned a quarter turn, as a place may turn it, counted as
-    tipped 90 degrees.)"""
+    put when the object turns about the vertical. (The object's own z axis does not: by it a
+    can lying on its side, set down turned a quarter turn, as a place may turn it, would
+    count as tipped 90 degrees.)"""
     return matrix_from_quat(quat).T @ np.array([0.0, 0.0, 1.0])
 
 

@@ -23,18 +23,17 @@ PLACE_ROOM = 0.07
 #: Where the dot of a place mark lands on something in front of the spot (an object between
 #: the seat and it), the user moves the aim by these (m, the surface's x back and y across)
 #: until the dot lies within `picking.DOT_ON_SPOT` of where they aim, as a person who
-#: watches the dot does; three marks on the side of a box in front of the spot were refused
-#: ("not on a flat surface") and the task was lost.
+#: watches the dot does: a mark on the side of a box in front of the spot is refused ("not
+#: on a flat surface").
 AIM_SHIFTS = ((0.0, 0.0), (0.0, 0.05), (0.0, -0.05), (0.0, 0.10), (0.0, -0.10), (0.05, 0.0))
 #: m the user moves a place mark the way the robot said when it refused it (`aim_as_told`):
-#: the wrist of a pill bottle's level hand came down 22 cm to the side of the object.
+#: a level hand's wrist comes down up to 22 cm to the side of the object.
 MARK_STEP = 0.15
 #: Where the line 25 cm behind a surface's front edge has no free spot, the user sets
 #: things down elsewhere on the top, nearest that line: these many random spots are
 #: weighed, SPOT_EDGE_ROOM (m) or more from the front and back edges and the object's
-#: footprint clear of them. Every place of a trial went to that line, so by its last tasks
-#: it was full: a plush toy found no spot on three surfaces, a TV remote none on three,
-#: though each had room behind (pick-place, seeds 200 and 1).
+#: footprint clear of them. Every place goes to that line first, so by a trial's last tasks
+#: it can be full while the top has room behind it.
 SPOT_TRIES = 400
 SPOT_EDGE_ROOM = 0.12
 
@@ -78,8 +77,8 @@ def free_spot(
 def room_for(op: ScriptedOperator, instance: str) -> float:
     """How far (m) the user keeps a spot from everything else to set `instance` down there:
     the reach of its footprint as it stands now (its points' farthest, level, from their
-    middle), plus PLACE_ROOM. 15 cm from the other objects' middles, whatever was held, set
-    the plush toy lying on its side down onto the glass cup's rim, which no camera sees."""
+    middle), plus PLACE_ROOM. A fixed distance from the other objects' middles, whatever is
+    held, sets a long object down onto its neighbour's rim."""
     pts = op.referee.object_points(instance, frame="world")[:, :2]
     middle = (pts.min(axis=0) + pts.max(axis=0)) / 2
     return float(np.linalg.norm(pts - middle, axis=1).max()) + PLACE_ROOM

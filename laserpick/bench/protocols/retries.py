@@ -24,11 +24,10 @@ RETRY_BACK = 0.10
 #: m to the left of straight before the arm that the user parks an object on a table instead,
 #: for the try after the arm said its only ways passed where the cameras could not see:
 #: nearer the middle of their view, as a person told so moves the scooter. Beside the arm,
-#: above the right-hand cameras' upper edge, no camera looks (seed 200 trial 1's juice bottle
-#: on the 108 cm table: every way up to it crossed x 1.25-1.74 m, z 1.02-1.41 m in `base`,
-#: unseen). Farther back did not help there: the high camera's upper edge falls as it looks
-#: farther. At a shelf the user still backs off, for the board (the top shelf's cereal box,
-#: parked so on seed 200, was lost where backing off had taken it).
+#: above the right-hand cameras' upper edge, no camera looks (on the 108 cm table every way
+#: up to an object there crosses x 1.25-1.74 m, z 1.02-1.41 m in `base`, unseen). Farther
+#: back does not help there: the high camera's upper edge falls as it looks farther. At a
+#: shelf the user still backs off, for the board.
 IN_VIEW_ACROSS = 0.20
 
 

@@ -63,6 +63,7 @@ def pair_scene(rng: np.random.Generator) -> Scene:
 
 
 def selection(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One selection trial: the same target picked with automatic and manual selection."""
     rng = np.random.default_rng(seed)
     scene = protocol_scene("", seed, opt) if opt.scene else pair_scene(rng)
     target = str(rng.choice(instances(scene)))

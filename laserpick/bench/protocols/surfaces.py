@@ -13,11 +13,12 @@ from laserpick.robot.sim.scenes import Scene, Surface
 
 #: m the user parks behind the `surfaces` scene's start row: there EL-E's objects stand
 #: 5-15 cm from the front edges, 20-30 cm in front of the arm's base, where few arm postures
-#: reach down (see "Known differences" in the README); a user soon learns to stop short.
+#: reach down; a user soon learns to stop short.
 SURFACES_BACK = 0.15
 
 
 def surfaces(trial: int, seed: int, opt: Options) -> list[Attempt]:
+    """One surfaces trial: the objects of each surface in turn, parked before it."""
     scene = protocol_scene("surfaces", seed, opt)
     out = []
     with scripted_operator(scene, trial, seed, opt) as op:

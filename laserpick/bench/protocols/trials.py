@@ -35,6 +35,9 @@ TrialFn = Callable[[int, int, Options], list[Attempt]]
 
 @dataclass(frozen=True)
 class Protocol:
+    """One protocol: its name on the command line, what it reruns, its defaults, and the
+    function that runs one trial."""
+
     name: str
     source: str  #: the paper and section it reruns
     trials: int  #: the paper's number of trials
@@ -47,6 +50,9 @@ class Protocol:
 def scripted_operator(
     scene: Scene, trial: int, seed: int, opt: Options
 ) -> Iterator[ScriptedOperator]:
+    """The scripted operator of trial `trial` on a fresh session in `scene`: the session,
+    the sensors and the operator's draws seeded by `seed`, the aim's tremor from `opt`. The
+    session is closed on leaving."""
     session = open_session(scene, seed)
     try:
         yield ScriptedOperator(
@@ -61,18 +67,22 @@ def scripted_operator(
 
 
 def protocol_scene(default: str, seed: int, opt: Options) -> Scene:
+    """The user's scene of `opt`, else the built-in scene `default`, loaded with `seed`."""
     return load_scene(opt.scene or default, seed=seed)
 
 
 def limit(names: list[str], opt: Options) -> list[str]:
+    """The first `opt.objects` of `names` (all of them when None)."""
     return names if opt.objects is None else names[: opt.objects]
 
 
 def shuffled(op: ScriptedOperator, names: list[str]) -> list[str]:
+    """A copy of `names` in a random order, drawn from the operator's generator."""
     names = list(names)
     op.rng.shuffle(names)
     return names
 
 
 def instances(scene: Scene) -> list[str]:
+    """The object instances of `scene`, in the order it places them."""
     return [p.instance for p in scene.placements]
