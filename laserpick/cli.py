@@ -118,6 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     serve.set_defaults(func=cmd_serve)
     _add_adapter_parser(sub)
+    _add_bench_parser(sub)
     return parser
 
 
@@ -191,6 +192,10 @@ def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
     )
     adapter.set_defaults(func=cmd_adapter)
 
+
+def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
+    """`laserpick bench`: rerun a paper's experiment (docs/bench.md), or compare two of its
+    result files."""
     from laserpick.bench import PROTOCOL_NAMES  # not .protocols: that loads the simulator
 
     bench = sub.add_parser(
