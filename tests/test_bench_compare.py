@@ -114,6 +114,8 @@ def test_floats_match_exactly_unless_a_tolerance_is_given(old: dict[str, Any]) -
     assert [[c.name for c in d.changes] for d in exact.differences] == [["grip"], ["execute_sim"]]
     assert compare_results(old, new, tolerance=1e-5).same
     assert not compare_results(old, new, tolerance=1e-7).same
+    with pytest.raises(ValueError, match="tolerance"):
+        compare_results(old, new, tolerance=-1.0)
 
 
 def test_results_of_another_protocol_or_seed_are_refused(old: dict[str, Any]) -> None:

@@ -202,7 +202,7 @@ def compare_results(
     """Compare two results attempt by attempt. Raises ResultMismatch when they ran another
     protocol or seed. tolerance: how far (absolute) floats may differ; 0: exactly."""
     if not math.isfinite(tolerance) or tolerance < 0:
-        raise ValueError(f"the tolerance must be a finite number >= 0, not {tolerance}")
+        raise ValueError(f"--tolerance must be a finite number >= 0, not {tolerance}")
     for key in ("protocol", "seed"):
         if old.get(key) != new.get(key):
             raise ResultMismatch(
