@@ -57,9 +57,6 @@ sys.path.insert(0, str(REPO / "tests"))
 
 from serve_process import ServeProcess  # noqa: E402
 
-# --- the server ----------------------------------------------------------------------------
-
-
 # --- the load ------------------------------------------------------------------------------
 
 
@@ -174,7 +171,65 @@ def latency(values: list[float]) -> str:
     )
 
 
+@dataclass
+class Load:
+    """What every thread of the load saw: the websocket readers, the /state pollers (one
+    per reader), the controller's commands and the real-time factor samples."""
+
+    readers: list[Stats]
+    pollers: list[Stats]
+    commands: Stats = field(default_factory=Stats)
+    rtf: Stats = field(default_factory=Stats)
+
+
+def start_watchers(
+    url: str, go: threading.Event, stop: threading.Event, readers: list[Stats]
+) -> list[threading.Thread]:
+    """One events websocket reader a Stats of `readers`, started."""
+    threads = [
+        threading.Thread(target=watch_events, args=(url, go, stop, s), daemon=True) for s in readers
+    ]
+    for t in threads:
+        t.start()
+    return threads
+
+
+def start_load(
+    url: str,
+    args: argparse.Namespace,
+    controller: Client,
+    start: float,
+    stop: threading.Event,
+    load: Load,
+) -> list[threading.Thread]:
+    """The /state pollers (spread over the read period, not all at once), the controller's
+    commands and the real-time factor sampler, started at `start`."""
+    threads = []
+    period = 1.0 / args.read_hz
+    for i, s in enumerate(load.pollers):
+        offset = start + period * i / args.readers
+        threads.append(
+            threading.Thread(
+                target=poll_state, args=(url, args.read_hz, offset, stop, s), daemon=True
+            )
+        )
+    threads.append(
+        threading.Thread(
+            target=command,
+            args=(controller, args.command_hz, start, stop, load.commands),
+            daemon=True,
+        )
+    )
+    threads.append(
+        threading.Thread(target=sample_rtf, args=(url, start, stop, load.rtf), daemon=True)
+    )
+    for t in threads:
+        t.start()
+    return threads
+
+
 def run(url: str, args: argparse.Namespace) -> int:
+    """Put the load on the server at `url` for `args.seconds` and print what it saw."""
     http = requests.Session()
     controller = Client(url, name="api_load bench", source="bench", timeout=10.0)
     try:
@@ -184,34 +239,13 @@ def run(url: str, args: argparse.Namespace) -> int:
         return 2
 
     stop, go = threading.Event(), threading.Event()
-    readers = [Stats() for _ in range(args.readers)]
-    pollers = [Stats() for _ in range(args.readers)]
-    commands, rtf = Stats(), Stats()
-    threads = [
-        threading.Thread(target=watch_events, args=(url, go, stop, s), daemon=True) for s in readers
-    ]
-    for t in threads:
-        t.start()
+    load = Load([Stats() for _ in range(args.readers)], [Stats() for _ in range(args.readers)])
+    threads = start_watchers(url, go, stop, load.readers)
     time.sleep(1.0)  # the websockets connect
     state0 = http.get(f"{url}{API}/state", timeout=10).json()
     wall0 = start = time.perf_counter()
     go.set()
-    period = 1.0 / args.read_hz
-    for i, s in enumerate(pollers):  # spread over the period, not all at once
-        offset = start + period * i / args.readers
-        threads.append(
-            threading.Thread(
-                target=poll_state, args=(url, args.read_hz, offset, stop, s), daemon=True
-            )
-        )
-    threads.append(
-        threading.Thread(
-            target=command, args=(controller, args.command_hz, start, stop, commands), daemon=True
-        )
-    )
-    threads.append(threading.Thread(target=sample_rtf, args=(url, start, stop, rtf), daemon=True))
-    for t in threads[args.readers :]:
-        t.start()
+    threads += start_load(url, args, controller, start, stop, load)
     time.sleep(args.seconds)
     stop.set()
     wall1 = time.perf_counter()
@@ -220,37 +254,46 @@ def run(url: str, args: argparse.Namespace) -> int:
         t.join(timeout=15)
     controller.release()
     wall = wall1 - wall0
+    print_load(url, args, load, wall, (state1["sim_time"] - state0["sim_time"]) / wall)
+    return 0
 
-    cmd_lat = commands.latencies
+
+def error_counts(load: Load) -> Counter[str]:
+    """Every error of the load: no answer, by exception type, and HTTP statuses other than
+    200 and 409 (state conflicts)."""
+    errors: Counter[str] = Counter()
+    for s in [load.commands, load.rtf, *load.pollers, *load.readers]:
+        errors.update(s.errors)
+        errors.update(
+            {f"HTTP {code}": n for code, n in s.statuses.items() if code not in (200, 409)}
+        )
+    return errors
+
+
+def print_load(url: str, args: argparse.Namespace, load: Load, wall: float, sim_rtf: float) -> None:
+    """Print what the load saw over `wall` s; sim_rtf: sim time over wall time."""
+    commands, readers, pollers, rtf = load.commands, load.readers, load.pollers, load.rtf
     read_lat = [x for s in pollers for x in s.latencies]
     hz = [s.frames / wall for s in readers]
     messages = sum(s.messages for s in readers)
     dropped = sum(s.gaps for s in readers)
     sent = sum(commands.statuses.values()) + sum(commands.errors.values())
-    conflicts = commands.statuses[409]
     cmd_errors = sum(n for code, n in commands.statuses.items() if code not in (200, 409))
     cmd_errors += sum(commands.errors.values())
     reads = sum(sum(s.statuses.values()) for s in pollers)
     read_errors = sum(n for s in pollers for code, n in s.statuses.items() if code != 200)
     read_errors += sum(sum(s.errors.values()) for s in pollers)
     ws_errors = sum(sum(s.errors.values()) for s in readers)
-    errors: Counter[str] = Counter()
-    for s in [commands, rtf, *pollers, *readers]:
-        errors.update(s.errors)
-        errors.update(
-            {f"HTTP {code}": n for code, n in s.statuses.items() if code not in (200, 409)}
-        )
-    sim_rtf = (state1["sim_time"] - state0["sim_time"]) / wall
-
+    errors = error_counts(load)
     print(
         f"server            {url}  ({args.readers} readers: events websocket + GET /state at "
         f"{args.read_hz:g} Hz; 1 controller at {args.command_hz:g} commands/s; {wall:.1f} s)"
     )
     print(
         f"commands          {sent} sent ({sent / wall:.1f}/s): {commands.statuses[200]} ok, "
-        f"{conflicts} conflicts (409), {cmd_errors} errors"
+        f"{commands.statuses[409]} conflicts (409), {cmd_errors} errors"
     )
-    print(f"command latency   {latency(cmd_lat)}")
+    print(f"command latency   {latency(commands.latencies)}")
     print(
         f"read latency      {latency(read_lat)}   "
         f"({reads} GET /state, {reads / wall:.1f}/s, {read_errors} errors)"
@@ -273,7 +316,6 @@ def run(url: str, args: argparse.Namespace) -> int:
             f"real-time factor  min {min(rtf.rtf):.3f}   mean {sum(rtf.rtf) / len(rtf.rtf):.3f}"
             f"   ({len(rtf.rtf)} samples of /health rtf; sim time / wall time {sim_rtf:.3f})"
         )
-    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

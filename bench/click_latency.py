@@ -1,4 +1,4 @@
-"""Click-to-highlight latency of the 3D console (issue 6's target: 250 ms or less).
+"""Click-to-highlight latency of the 3D console (target: 250 ms or less).
 
 A real `laserpick serve` on `isolation`, and its page at `/` in headless Chromium, the 3D view
 in the page's frame at the detail the page chooses (`--detail`; "auto" is half on this
@@ -32,6 +32,7 @@ import statistics
 import sys
 import tempfile
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -96,7 +97,19 @@ def open_view(browser: Any, server: ServeProcess, detail: str, probe: str) -> tu
     return page, frame
 
 
-def main() -> int:
+@dataclass
+class Latencies:
+    """What the browser trials measured (ms)."""
+
+    drawn: list[float] = field(default_factory=list)  #: click to the frame drawing the highlight
+    sent: list[float] = field(default_factory=list)  #: click to the lit cloud (or its message) sent
+    #: from the click's arrival in the server
+    server_share: list[float] = field(default_factory=list)
+    frames: list[float] = field(default_factory=list)  #: the browser's animation frame intervals
+    lost: int = 0  #: confirming clicks the view did not take as one
+
+
+def parse_args() -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=2, help="passes over the six objects")
     parser.add_argument("--no-browser", action="store_true", help="the server's share alone")
@@ -113,13 +126,14 @@ def main() -> int:
         default="auto",
         help="the page's 3D view detail setting (auto: half without a GPU)",
     )
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def main() -> int:
+    args = parse_args()
     if args.no_browser:
         return server_only(args.rounds)
-    drawn: list[float] = []  #: click to the frame that draws the highlight (ms)
-    sent: list[float] = []  #: click to the lit cloud (or the message showing it) sent (ms)
-    server_share: list[float] = []  #: from the click's arrival in the server (ms)
-    lost = 0  #: confirming clicks the view did not take as one
+    out = Latencies()
     with tempfile.TemporaryDirectory() as tmp:
         server = ServeProcess(Path(tmp), extra_args=("--lite-view",)).start()
         # The bench holds the operator station's lease; the 3D view's clicks act under it.
@@ -135,67 +149,76 @@ def main() -> int:
                 box = page.frame_locator("iframe#view").locator("canvas").first.bounding_box()
                 for _ in range(args.rounds):
                     for obj in objects:
-                        x, y = default_view_pixel(obj["center_base"], box["width"], box["height"])
-                        x, y = box["x"] + x, box["y"] + y
-                        page.mouse.click(x, y)
-                        api.wait_for(lambda s: s["state"] == "aiming" and not s["busy"], 20)
-                        time.sleep(args.pause)
-                        seen = len(api.events)
-                        page.mouse.click(x, y)
-                        # The click reaches the server on its own path: wait until it has
-                        # taken it (the mark is confirmed), then until the work is done.
-                        try:
-                            api.wait_for(lambda s: s["state"] != "aiming" or s["busy"], 10)
-                        except TimeoutError:
-                            lost += 1
-                            print(f"{obj['name']:>18}: the confirming click was not taken")
-                            api.post("/cancel")
-                            continue
-                        state = api.wait_for(lambda s: not s["busy"], 60)
-                        time.sleep(0.5)
-                        clicked = frame.evaluate("window.__lp.downs")[-1] / 1000.0
-                        shown = [
-                            e
-                            for e in api.events[seen:]
-                            if e["name"] == "highlight" and e["t"] > clicked
-                        ]
-                        if not shown:
-                            print(f"{obj['name']:>18}: no highlight ({state['message']})")
-                            api.post("/cancel")
-                            continue
-                        lit = shown[0]
-                        draws = frame.evaluate("window.__lp.draws")
-                        first = [t for t, n in draws if n == lit["points"] and t > clicked * 1e3]
-                        sent.append(1000.0 * (lit["t"] - clicked))
-                        share = 1000.0 * (lit.get("since_click") or float("nan"))
-                        server_share.append(share)
-                        drew = f"{first[0] - clicked * 1e3:6.0f} ms" if first else "   not seen"
-                        if first:
-                            drawn.append(first[0] - clicked * 1e3)
-                        print(
-                            f"{obj['name']:>18}: drawn {drew}; sent {sent[-1]:4.0f} ms, of which"
-                            f" the server {share:4.0f} ms  ({state['state']})"
-                        )
-                        api.post("/cancel")
-                frames = frame.evaluate("window.__lp.frames")
+                        click_trial(api, page, frame, box, obj, args.pause, out)
+                out.frames = frame.evaluate("window.__lp.frames")
                 browser.close()
         finally:
             api.release()
             server.close()
-    if not drawn:
+    if not out.drawn:
         print("no highlight was seen drawn")
         return 1
+    print_latencies(out)
+    return 0
+
+
+def click_trial(
+    api: Client, page: Any, frame: Any, box: dict, obj: dict, pause: float, out: Latencies
+) -> None:
+    """Click on `obj` in the 3D view (aim), wait `pause` s, click again (confirm), and add
+    the times to the highlight sent and drawn to `out`; the mark is cancelled after."""
+    x, y = default_view_pixel(obj["center_base"], box["width"], box["height"])
+    x, y = box["x"] + x, box["y"] + y
+    page.mouse.click(x, y)
+    api.wait_for(lambda s: s["state"] == "aiming" and not s["busy"], 20)
+    time.sleep(pause)
+    seen = len(api.events)
+    page.mouse.click(x, y)
+    # The click reaches the server on its own path: wait until it has taken it (the mark is
+    # confirmed), then until the work is done.
+    try:
+        api.wait_for(lambda s: s["state"] != "aiming" or s["busy"], 10)
+    except TimeoutError:
+        out.lost += 1
+        print(f"{obj['name']:>18}: the confirming click was not taken")
+        api.post("/cancel")
+        return
+    state = api.wait_for(lambda s: not s["busy"], 60)
+    time.sleep(0.5)
+    clicked = frame.evaluate("window.__lp.downs")[-1] / 1000.0
+    shown = [e for e in api.events[seen:] if e["name"] == "highlight" and e["t"] > clicked]
+    if not shown:
+        print(f"{obj['name']:>18}: no highlight ({state['message']})")
+        api.post("/cancel")
+        return
+    lit = shown[0]
+    draws = frame.evaluate("window.__lp.draws")
+    first = [t for t, n in draws if n == lit["points"] and t > clicked * 1e3]
+    out.sent.append(1000.0 * (lit["t"] - clicked))
+    share = 1000.0 * (lit.get("since_click") or float("nan"))
+    out.server_share.append(share)
+    drew = f"{first[0] - clicked * 1e3:6.0f} ms" if first else "   not seen"
+    if first:
+        out.drawn.append(first[0] - clicked * 1e3)
+    print(
+        f"{obj['name']:>18}: drawn {drew}; sent {out.sent[-1]:4.0f} ms, of which"
+        f" the server {share:4.0f} ms  ({state['state']})"
+    )
+    api.post("/cancel")
+
+
+def print_latencies(out: Latencies) -> None:
+    drawn, sent, frames = out.drawn, out.sent, out.frames
     print(
         f"\nclick-to-highlight over {len(drawn)} of {len(sent)} marks, to the frame that draws"
         f" it: median {statistics.median(drawn):.0f} ms, p90 {np.percentile(drawn, 90):.0f} ms,"
         f" max {max(drawn):.0f} ms (target 250). To it sent: median"
         f" {statistics.median(sent):.0f} ms; the server's share (click arrived to sent): median"
-        f" {statistics.median(server_share):.0f} ms; the browser's frame interval: median"
+        f" {statistics.median(out.server_share):.0f} ms; the browser's frame interval: median"
         f" {statistics.median(frames):.0f} ms, p90 {np.percentile(frames, 90):.0f} ms (software"
         f" WebGL); confirming clicks not taken:"
-        f" {lost}"
+        f" {out.lost}"
     )
-    return 0
 
 
 def server_only(rounds: int) -> int:
@@ -204,7 +227,7 @@ def server_only(rounds: int) -> int:
 
     import viser
 
-    from laserpick.bench.operator import Referee
+    from laserpick.bench.referee import Referee
     from laserpick.console.operator_console import OperatorConsole
     from laserpick.robot.sim.robot import SimRobot
     from laserpick.robot.sim.scenes import load_scene

@@ -85,7 +85,21 @@ def capture_loop(sim: Simulation, period: float, stop: threading.Event, out: Cap
         out.error = exc
 
 
-def main(argv: list[str] | None = None) -> int:
+@dataclass
+class Window:
+    """What the measured window saw: sim and wall seconds, the sim's own last real-time
+    factor, the viewer's updates and the capture rounds in it, and the browser clients."""
+
+    sim_s: float
+    wall_s: float
+    last_rtf: float
+    updates: int
+    captures: int
+    clients: int
+    viewer_hz: float  #: the viewer's target update rate
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=30.0, help="measured wall time (s)")
     parser.add_argument("--warmup", type=float, default=10.0, help="unmeasured start (s)")
@@ -105,16 +119,18 @@ def main(argv: list[str] | None = None) -> int:
         help="slack for --check: a loop paced to the wall clock cannot beat 1.0, and snapshot "
         "times come in 20 ms chunks (default 0.01)",
     )
-    args = parser.parse_args(argv)
-    width, height = (int(v) for v in args.viewport.lower().split("x"))
+    return parser.parse_args(argv)
 
+
+def measure(args: argparse.Namespace, width: int, height: int, cap: CaptureStats) -> Window | int:
+    """Run the simulation, the viewer with one browser client and the capture thread; after
+    the warm-up, measure for `args.seconds`. An exit code where the browser never connected."""
     from playwright.sync_api import sync_playwright
 
     sim = Simulation(load_scene(args.scene), realtime=True)
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     viewer = SceneViewer(sim, server)
     stop = threading.Event()
-    cap = CaptureStats()
     capture = threading.Thread(
         target=capture_loop,
         args=(sim, 1.0 / args.capture_hz, stop, cap),
@@ -154,23 +170,40 @@ def main(argv: list[str] | None = None) -> int:
             capture.join(timeout=10)
         sim.close()
         server.stop()
+    return Window(
+        snap1.time - snap0.time,
+        wall1 - wall0,
+        snap1.rtf,
+        updates1 - updates0,
+        captures1 - captures0,
+        clients,
+        viewer.rate_hz,
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    width, height = (int(v) for v in args.viewport.lower().split("x"))
+    cap = CaptureStats()
+    window = measure(args, width, height, cap)
+    if isinstance(window, int):
+        return window
     if cap.error is not None:
         print(f"realtime_factor: capture failed: {cap.error!r}", file=sys.stderr)
         return 2
 
-    sim_s, wall_s = snap1.time - snap0.time, wall1 - wall0
+    sim_s, wall_s = window.sim_s, window.wall_s
     rtf = sim_s / wall_s
-    n_cap = captures1 - captures0
     mean_cap = sum(cap.durations) / len(cap.durations) if cap.durations else float("nan")
-    print(f"scene            {args.scene}  (browser {width}x{height}, {clients} client)")
+    print(f"scene            {args.scene}  (browser {width}x{height}, {window.clients} client)")
     print(f"sim seconds      {sim_s:8.2f}")
     print(f"wall seconds     {wall_s:8.2f}")
-    print(f"RTF              {rtf:8.4f}   (sim's own last 0.5 s window: {snap1.rtf:.3f})")
+    print(f"RTF              {rtf:8.4f}   (sim's own last 0.5 s window: {window.last_rtf:.3f})")
     print(
-        f"capture rate     {n_cap / wall_s:8.2f} rounds/s of 5 frames "
+        f"capture rate     {window.captures / wall_s:8.2f} rounds/s of 5 frames "
         f"(target {args.capture_hz:g}; mean round {mean_cap * 1000:.0f} ms)"
     )
-    print(f"viewer updates   {(updates1 - updates0) / wall_s:8.2f} Hz (target {viewer.rate_hz:g})")
+    print(f"viewer updates   {window.updates / wall_s:8.2f} Hz (target {window.viewer_hz:g})")
     if args.check and rtf < 1.0 - args.tolerance:
         print(f"realtime_factor: RTF {rtf:.4f} < 1.0 - {args.tolerance:g}", file=sys.stderr)
         return 1

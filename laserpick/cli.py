@@ -7,6 +7,7 @@
     laserpick bench --protocol P [--trials N] [--seed S] [--selection auto|manual]
                     [--strategy gpd|overhead|jeeves] [--scene FILE] [--out FILE.json]
                     [--workers N] [--ray ADDRESS] [--tremor DEG] [--objects N]
+    laserpick bench --compare OLD.json NEW.json [--tolerance T]
 
 `serve` loads a scene (a built-in name or a YAML path), runs the real-time simulation and the
 operator session, serves the page and the API (uvicorn) and the viser 3D view, and records
@@ -24,10 +25,12 @@ pipeline runs on the recorded frames and nothing moves; no simulator is loaded, 
 view is not served. `record` writes such a recording from a scene simulated headless, with the
 laser confirmed on an object if asked (the format: docs/recording.md).
 
-`bench` reruns one of the papers' experiments with the scripted operator (docs/bench.md).
+`bench` reruns one of the papers' experiments with the scripted operator (docs/bench.md);
+`bench --compare` lists the attempts that differ between two of its result files.
 
-Exit codes: 0 clean shutdown (or a finished benchmark), 1 a benchmark trial broke off (the
-others' results are still written), 2 bad usage (unknown scene, refused host, a bad count).
+Exit codes: 0 clean shutdown (or a finished benchmark, or two results with no difference),
+1 a benchmark trial broke off (the others' results are still written) or the compared results
+differ, 2 bad usage (unknown scene, refused host, a bad count, an unreadable result file).
 """
 
 from __future__ import annotations
@@ -139,6 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.set_defaults(func=cmd_serve)
     _add_record_parser(sub)
     _add_adapter_parser(sub)
+    _add_bench_parser(sub)
     return parser
 
 
@@ -231,6 +235,10 @@ def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
     )
     adapter.set_defaults(func=cmd_adapter)
 
+
+def _add_bench_parser(sub: argparse._SubParsersAction) -> None:
+    """`laserpick bench`: rerun a paper's experiment (docs/bench.md), or compare two of its
+    result files."""
     from laserpick.bench import PROTOCOL_NAMES  # not .protocols: that loads the simulator
 
     bench = sub.add_parser(
@@ -239,7 +247,7 @@ def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
         description="Run a benchmark protocol with the scripted operator and write the result"
         " JSON, a Markdown report and PNG plots (the schema is in docs/bench.md).",
     )
-    bench.add_argument("--protocol", required=True, choices=PROTOCOL_NAMES, help="which experiment")
+    bench.add_argument("--protocol", choices=PROTOCOL_NAMES, help="which experiment (required)")
     bench.add_argument("--trials", type=int, help="trials to run (default: the paper's number)")
     bench.add_argument("--seed", type=int, default=1, help="trial k uses seed SEED + k")
     bench.add_argument("--selection", choices=["auto", "manual"], help="grasp selection")
@@ -259,6 +267,20 @@ def _add_adapter_parser(sub: argparse._SubParsersAction) -> None:
         "--tremor", type=float, default=0.3, help="aim noise, deg standard deviation (0.3)"
     )
     bench.add_argument("--objects", type=int, help="at most this many objects per trial")
+    bench.add_argument(
+        "--compare",
+        nargs=2,
+        type=Path,
+        metavar=("OLD.json", "NEW.json"),
+        help="run nothing: list the attempts that differ between two result files (exit 1 if"
+        " any differ)",
+    )
+    bench.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.0,
+        help="with --compare: how far floats may differ (absolute, m or s; default 0: exactly)",
+    )
     bench.set_defaults(func=cmd_bench)
 
 
@@ -269,8 +291,37 @@ def cmd_adapter(args: argparse.Namespace) -> int:
     return run(args)
 
 
+def cmd_bench_compare(old: Path, new: Path, tolerance: float) -> int:
+    """List the attempts that differ between two result files: 0 when none does, 1 when
+    some do, 2 when a file cannot be read or the two ran another protocol or seed."""
+    from laserpick.bench.compare import compare_files, format_comparison
+
+    try:
+        comparison = compare_files(old, new, tolerance)
+    except ValueError as exc:  # unreadable, mismatched, or a bad tolerance
+        _say(str(exc), err=True)
+        return EXIT_USAGE
+    print(format_comparison(comparison, str(old), str(new)), end="")
+    return 0 if comparison.same else 1
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
-    """Run a protocol with a progress bar; write the JSON, the report and the plots."""
+    """Run a protocol with a progress bar; write the JSON, the report and the plots. With
+    --compare, compare two result files instead."""
+    if args.compare is not None:
+        if args.protocol is not None:
+            _say("--compare compares two result files; it takes no --protocol", err=True)
+            return EXIT_USAGE
+        return cmd_bench_compare(*args.compare, args.tolerance)
+    if args.protocol is None:
+        _say("bench needs --protocol (or --compare OLD.json NEW.json)", err=True)
+        return EXIT_USAGE
+    return run_bench(args)
+
+
+def run_bench(args: argparse.Namespace) -> int:
+    """Run the protocol of `args` with a progress bar; write the JSON, the report and the
+    plots."""
     import json
 
     from laserpick.bench.protocols import PROTOCOLS, Options

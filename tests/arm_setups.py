@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker

@@ -11,7 +11,7 @@ import pytest
 from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, isolation_robot, pick_object
 
 from laserpick.behaviours import Behaviours, basket_opening, drop_candidates, drop_configurations
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker

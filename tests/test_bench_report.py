@@ -11,11 +11,10 @@ from typing import Any
 import pytest
 from PIL import Image
 
-from laserpick.bench import PROTOCOL_NAMES, papers, report
+from laserpick.bench import FAILURE_KINDS, PROTOCOL_NAMES, STAGES, papers, report, targets
 
-KINDS = report.FAILURE_KINDS
-STAGES = report.STAGES
-GRASP_TARGET = papers.TARGETS[0].label
+KINDS = FAILURE_KINDS
+GRASP_TARGET = targets.TARGETS[0].label
 
 
 def _record(
@@ -237,7 +236,7 @@ def test_selection_puts_both_modes_side_by_side():
     assert manual[1:4] == ["manual", "8.0 % (4/50)", "0.0 % (0/4)"]
     assert _rows(met, "measure")[0][1:] == ["auto", "manual"]
     assert "### Automatic selection" in met and "### Manual selection" in met
-    label = papers.TARGETS[4].label
+    label = targets.TARGETS[4].label
     assert _rows(met, label)[0][-1] == "met"
     same = report.markdown(_result("selection", _selection_records(manual_wrong=2)))
     assert _rows(same, label)[0][-1] == "**NOT MET**"  # 50 % is not at most half of 50 %

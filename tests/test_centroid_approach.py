@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
+from laserpick.bench.referee import Referee
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot

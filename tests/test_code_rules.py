@@ -278,7 +278,7 @@ def test_a_transitive_import_of_the_simulator_is_caught(planted, tmp_path):
 
 
 def test_a_server_module_importing_the_bench_is_caught(planted, tmp_path):
-    planted("laserpick.server.app", "from laserpick.bench.operator import Referee\n")
+    planted("laserpick.server.app", "from laserpick.bench.referee import Referee\n")
     graph = import_graph(tmp_path / "laserpick", tmp_path)
     assert offenders(graph, ("laserpick.server",), ("laserpick.bench",))
 

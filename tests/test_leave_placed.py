@@ -18,7 +18,7 @@ from arm_setups import (
 )
 
 from laserpick.behaviours import Behaviours
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker

@@ -114,7 +114,7 @@ def test_the_overhead_grasp_of_a_pill_beside_a_phone_closes_on_the_pill(tmp_path
     phone, 9 of 12 pills). As `surfaces` sets out EL-E's second table, seen from where the
     user parks."""
     from laserpick.bench.picking import BENCH
-    from laserpick.bench.protocols import Options, _operated
+    from laserpick.bench.protocols import Options, scripted_operator
     from laserpick.robot.sim.scenes import load_scene
     from laserpick.server.session import TaskState
 
@@ -127,7 +127,7 @@ def test_the_overhead_grasp_of_a_pill_beside_a_phone_closes_on_the_pill(tmp_path
         "  - {name: phone, model: cordless_phone, on: t, xy: [1.57, -0.27], yaw_deg: 30}\n"
         "  - {name: pill, model: pill, on: t, xy: [1.60, -0.05], yaw_deg: 45}\n"
     )
-    with _operated(load_scene(str(scene)), 0, 1, Options(tremor_deg=0.0)) as op:
+    with scripted_operator(load_scene(str(scene)), 0, 1, Options(tremor_deg=0.0)) as op:
         s = op.session
         s.set_mode(BENCH, strategy="overhead")
         assert op.mark(op.new_attempt("pill", "auto", "overhead"))

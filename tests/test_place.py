@@ -19,7 +19,7 @@ from laserpick.behaviours import (
     place_poses,
     turned_hand_xy,
 )
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose

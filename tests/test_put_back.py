@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from arm_setups import TABLE_TOP, isolation_robot, pick_object
 
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.description.kinematics import tcp_pose
 from laserpick.transforms import matrix_from_quat
 

@@ -15,7 +15,7 @@ import pytest
 from driving import drive_back_and_in
 from scipy.spatial import cKDTree
 
-from laserpick.bench.operator import Referee
+from laserpick.bench.referee import Referee
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     CARRIED_PADDING,

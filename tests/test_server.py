@@ -21,7 +21,7 @@ from basket import judge_drop, lost_in_carry
 from serve_process import ServeProcess
 from websockets.sync.client import connect
 
-from laserpick.bench.operator import parking_pose
+from laserpick.bench.parking import parking_pose
 from laserpick.client import API, ApiError, Client
 from laserpick.description import dims
 from laserpick.robot.sim.scenes import load_scene, scene_config

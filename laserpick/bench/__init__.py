@@ -1,7 +1,21 @@
 """Benchmarks: the papers' experiments rerun in simulation with a scripted operator.
 
-`laserpick bench --protocol NAME` runs one (see `protocols` and docs/bench.md).
+`laserpick bench --protocol NAME` runs one (see `protocols` and docs/bench.md);
+`laserpick bench --compare OLD.json NEW.json` lists the attempts that differ between two
+runs (`compare`).
+
+- `protocols/`: the experiments, one module each; `runner`: their trials inline, in worker
+  processes or on Ray; `results`: the result JSON; `attempts`: one attempt's record.
+- `picking`: the scripted operator, through the session; `referee`: the simulator's truth it
+  reads to aim and drive; `parking`, `driving` and `route_planning`: where it parks and how
+  it drives there.
+- `papers/`: the papers' published figures; `targets`: ours; `report/`: Markdown and PNG;
+  `scoring`: scores against the truth.
+
+Importing this package loads no simulator: the command line parses with PROTOCOL_NAMES.
 """
+
+__all__ = ["FAILURE_KINDS", "PROTOCOL_NAMES", "STAGES"]
 
 #: The protocols, in the order the papers' experiments are listed (`protocols.PROTOCOLS` has
 #: the same keys; kept here so that the command line parses without loading the simulator).

@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from laserpick.bench.operator import TREMOR_STD, Referee
+from laserpick.bench.attempts import Attempt, stage_timings
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
@@ -36,6 +37,9 @@ from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure
 
 BENCH = Actor("bench")
+#: Hand tremor: the aim's angular noise, standard deviation (rad). About 5 mm at 1 m, a
+#: steady hand resting on the scooter's armrest. Ours; 004 does not measure it.
+TREMOR_STD = math.radians(0.3)
 #: Marks the operator makes again after the mark itself failed (the dots missed, or no object
 #: under them), as 004's users re-aimed.
 REMARKS = 2
@@ -50,7 +54,7 @@ DOT_ON_SPOT = 0.03
 JOB_TIMEOUT = 600.0
 #: The farthest (m) a user choosing by hand lets a grasp hold an object off its balance: an
 #: object held farther from its centre of mass, across the line between the fingers, swings
-#: about that line in the pads (a TV remote held near one end was set down on its side).
+#: about that line in the pads (a TV remote held near one end turns onto its side).
 LEVER_MAX = 0.02
 #: How near (m) a cluster's best grasp must lie to one the user saw fail to plan for them to
 #: take it for the same and pass it by: half 004's cluster bound (section 7.2). Neighbouring
@@ -58,41 +62,6 @@ LEVER_MAX = 0.02
 UNPLANNED_NEAR = 0.01
 #: The session's progress messages at the moment the hand lets go of the object.
 RELEASED = frozenset({"Released into the basket.", "Placed."})
-
-
-@dataclass
-class Attempt:
-    """The record of one grasp attempt on one marked object (JSON-ready through `as_dict`)."""
-
-    trial: int
-    seed: int
-    instance: str
-    model: str
-    surface: str | None
-    selection: str
-    strategy: str
-    task: int = 0  #: which task of the trial: the tries at one object share it
-    marks: int = 0  #: marks made (re-marks after a missed dot count)
-    places: int = 0  #: place marks confirmed (pick and place)
-    detected: bool = False  #: the grasp chosen (or executed) was on the marked object
-    #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)
-    grasped: bool = False
-    success: bool = False  #: the attempt's task was done (in the basket, or placed upright)
-    failure: str | None = None  #: one of FAILURE_KINDS when it did not succeed
-    message: str = ""
-    timings: dict[str, float] = field(default_factory=dict)  #: s per STAGES entry
-    #: the executed grasp's planned width and the finger gap it closed to (m): an object
-    #: held across an edge or turned in the pads closes narrower than planned
-    grip: tuple[float, float] | None = None
-    #: how far (m) the executed grasp held the object off its centre of mass (`lever`)
-    lever: float | None = None
-
-    def fail(self, kind: str, message: str) -> Attempt:
-        self.failure, self.message = kind, message
-        return self
-
-    def as_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 def trial_settings(seed: int) -> Settings:
@@ -237,7 +206,7 @@ class ScriptedOperator:
             k = len(self._events)
             s.confirm(BENCH)
             self.wait()
-            rec.timings = _stages(self._events_since(k, "job"))
+            rec.timings = stage_timings(self._events_since(k, "job"))
             if s.state == TaskState.GRASPS_READY:
                 rec.failure, rec.message = None, ""  # an earlier mark's miss is behind us
                 return True
@@ -254,8 +223,7 @@ class ScriptedOperator:
         LEVER_MAX about its centre of mass `centre`, m, `base`), as a person who sees the
         object would hold it; else to the first on `instance` at all; none such: back to the
         system's choice. Clusters where a choice failed to plan before are passed by while
-        another on `instance` is left: a cluster of one grasp that cannot be planned ended a
-        pick-place try on a shelf, and the next try chose it again."""
+        another on `instance` is left: a person does not choose again what they saw fail."""
         s = self.session
         failed = self._unplanned.get(instance, [])
         best: tuple[tuple[bool, bool], int] | None = None  # (tried, off balance), cluster
@@ -301,7 +269,7 @@ class ScriptedOperator:
         self.wait()
         execute_sim = self._released_at(k) - t_sim
         done = self._events_since(k, "job")
-        rec.timings = _stages(done, execute_sim)  # the task's last job reports all its stages
+        rec.timings = stage_timings(done, execute_sim)  # the task's last job reports all its stages
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
@@ -372,9 +340,8 @@ class ScriptedOperator:
                 self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
             # What the hand holds is found before it opens: in the second the gripper takes,
-            # a held object falls clear of the fingers, and was left lying where the scooter
-            # stood (seed 100's pill bottle, in front of the 73 cm table, where the user then
-            # could not park for the mug).
+            # a held object falls clear of the fingers, and would lie where the scooter
+            # stands, in the way of the next parking.
             in_hand = (
                 [n for n in self.referee.instances() if self.referee.near_hand(n)]
                 if s.behaviours.held is not None
@@ -386,8 +353,8 @@ class ScriptedOperator:
                 self.referee.take_out(name)
         if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
             # By hand, as the experimenter would: a stow from here has no cloud to plan
-            # around (the session, which had one, did not get the arm home), and one put the
-            # fingers into the 87 cm counter at 159 N, moving what stood on it.
+            # around (the session, which had one, did not get the arm home), and can drive
+            # the fingers into the furniture.
             self.referee.move_arm_home()
         s.resync(BENCH)
 
@@ -410,26 +377,3 @@ class Placed:
 
     failure: Failure | None
     hit: np.ndarray | None
-
-
-def _stages(jobs: list[dict[str, Any]], execute_sim: float | None = None) -> dict[str, float]:
-    """The STAGES timings of one attempt from its session jobs' reports (the last report of
-    a task holds all its stages)."""
-    raw: dict[str, float] = {}
-    for job in jobs:
-        raw.update(job.get("timings", {}))
-    out = {
-        "acquire_cloud": raw.get("capture", 0.0) + raw.get("fuse", 0.0),
-        "detect_laser": raw.get("detect_laser"),
-        "segment": raw.get("segment"),
-        "detect_grasp": raw.get("detect"),
-        "filter": raw.get("filter"),
-        "select": raw.get("select"),
-        "plan": raw.get("plan"),
-        "execute_sim": execute_sim,
-    }
-    timings = {k: float(v) for k, v in out.items() if v is not None}
-    if "fuse" not in raw:
-        timings.pop("acquire_cloud")
-    timings["attempt_total"] = math.fsum(timings.values())
-    return timings

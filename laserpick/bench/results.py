@@ -22,8 +22,8 @@ from laserpick.bench import FAILURE_KINDS, STAGES
 
 #: The packages whose versions a run's outcomes depend on: the simulation's contacts, the
 #: cloud's geometry and the solvers'. Within pyproject.toml's ranges another version moves
-#: single attempts (`selection`'s trial 5 mug, held in one `.venv` and dropped in the next),
-#: so constraints.txt pins each of them to the version the figures were measured with.
+#: single attempts (an object held under one version is dropped under the next), so
+#: constraints.txt pins each of them to the version the figures were measured with.
 RESULT_PACKAGES = (
     "mujoco",
     "numpy",

@@ -1,0 +1,53 @@
+"""When the scripted user tries an object again (in-situ and pick-place), and where they park
+for the next try."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from laserpick.bench.attempts import Attempt
+from laserpick.bench.picking import ScriptedOperator
+from laserpick.pipeline.grasping import UNSEEN_WAYS
+from laserpick.robot.sim.scenes import Scene
+
+#: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until
+#: retrieved; in section 8.3 a task could take more than one pick-and-place attempt, 150
+#: grasp and 104 place attempts for 84 tasks in Table 5), and place marks per pick.
+MAX_TRIES = 3
+#: An object still within this (m) of where it stood, across and in height, can be tried
+#: again: a failed attempt left it in place, or only nudged it.
+STILL_THERE = (0.05, 0.02)
+#: m the user parks farther back for each try after the arm could not take the object (an
+#: ik_plan failure), as a person told that the arm cannot reach moves the scooter: under a
+#: shelf's board the arm needs room to come in level.
+RETRY_BACK = 0.10
+#: m to the left of straight before the arm that the user parks an object on a table instead,
+#: for the try after the arm said its only ways passed where the cameras could not see:
+#: nearer the middle of their view, as a person told so moves the scooter. Beside the arm,
+#: above the right-hand cameras' upper edge, no camera looks (on the 108 cm table every way
+#: up to an object there crosses x 1.25-1.74 m, z 1.02-1.41 m in `base`, unseen). Farther
+#: back does not help there: the high camera's upper edge falls as it looks farther. At a
+#: shelf the user still backs off, for the board.
+IN_VIEW_ACROSS = 0.20
+
+
+def next_try(rec: Attempt, back: float, across: float, scene: Scene) -> tuple[float, float]:
+    """Where the user parks for the next try after `rec` (back, across: m, as in
+    `go_to_object`): where the arm could not take the object, farther back (RETRY_BACK),
+    or, where it stands on a table or a counter (not a shelf, as `scene` placed it) and the
+    arm said that only unseen space kept it from the object, first with it nearer the
+    middle of the cameras' view (IN_VIEW_ACROSS)."""
+    if rec.failure != "ik_plan":
+        return back, across
+    shelf = scene.surface(scene.placement(rec.instance).surface).kind == "shelf"
+    if not shelf and UNSEEN_WAYS in (rec.message or "") and across == 0.0:
+        return back, IN_VIEW_ACROSS
+    return back + RETRY_BACK, across
+
+
+def still_there(op: ScriptedOperator, name: str, stood: np.ndarray) -> bool:
+    """Whether the object is still where it stood (m, `world`), within STILL_THERE: not
+    fallen, carried off or taken out, so the user can try it again."""
+    now = op.referee.world_position(name)
+    across, height = STILL_THERE
+    return bool(np.linalg.norm(now[:2] - stood[:2]) < across and abs(now[2] - stood[2]) < height)
