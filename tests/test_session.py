@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from driving import drive_straight
 
-from laserpick.behaviours import HOLD_TURNS, PAST_THE_OPENING, Held, Outcome
+from laserpick.behaviours import PAST_THE_OPENING, Held, Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasping import GraspSet
@@ -361,7 +361,9 @@ def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() 
             held = b.held
             assert held is not None, out.failure
             held_at = []
-            for q, turn in itertools.product((dims.UR5_CARRY_Q, dims.UR5_HIGH_READY_Q), HOLD_TURNS):
+            for q, turn in itertools.product(
+                (dims.UR5_CARRY_Q, dims.UR5_HIGH_READY_Q), b.settings.behaviour.hold_turns
+            ):
                 turned = q.copy()
                 turned[5] += turn
                 held_at.append(held.at(tcp_pose(turned)))

@@ -38,15 +38,12 @@ from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses
 from laserpick.behaviours.put_back import PuttingBack
 from laserpick.behaviours.stow import Stowing
 from laserpick.behaviours.withdraw import Withdrawing
-from laserpick.settings import BehaviourSettings
 
 __all__ = [
     "GRIPPER_TIME",
-    "HOLD_TURNS",
     "MARK_MOVES",
     "NOT_HOLDING",
     "PAST_THE_OPENING",
-    "SUPPORT_SCATTER",
     "Approaching",
     "BasketDrop",
     "Behaviours",
@@ -74,13 +71,6 @@ __all__ = [
     "turned_hand_xy",
     "without_leftovers",
 ]
-
-#: The default of `BehaviourSettings.support_scatter` (m), for callers not yet reading the
-#: settings.
-SUPPORT_SCATTER: float = BehaviourSettings.model_fields["support_scatter"].default
-#: The default of `BehaviourSettings.hold_turns` (rad), for callers not yet reading the
-#: settings.
-HOLD_TURNS: tuple[float, ...] = BehaviourSettings.model_fields["hold_turns"].default
 
 
 class Behaviours(Picking, BasketDrop, Placing, PuttingBack, Approaching):

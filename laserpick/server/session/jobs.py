@@ -11,7 +11,6 @@ import time
 
 import numpy as np
 
-from laserpick.behaviours import SUPPORT_SCATTER
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasping import find_grasps
@@ -108,7 +107,7 @@ class Jobs(Retreat, Foresight):
         out = self.behaviours.pick(grasps, order)
         if self.behaviours.held is not None:
             # The object has left its place: the views of the way in must not keep it there.
-            above = grasps.stands_on + SUPPORT_SCATTER
+            above = grasps.stands_on + self.settings.behaviour.support_scatter
             self.views.forget(grasps.carried, self.robot.base_pose(), above)
         self.task.timings.update(out.timings)
         if out.grasp is not None:  # the grasp that planned: in auto, not always the first
