@@ -39,8 +39,10 @@ import viser
 from laserpick.console import headless_chromium
 from laserpick.console.viewer import SceneViewer
 from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.sensors import DepthCameras
+from laserpick.robot.sim.world_view import SimWorld
 from laserpick.settings import get_settings
 
 
@@ -110,9 +112,10 @@ def main(argv: list[str] | None = None) -> int:
 
     from playwright.sync_api import sync_playwright
 
-    sim = Simulation(load_scene(args.scene), realtime=True)
+    robot = SimRobot(load_scene(args.scene), realtime=True)  # its loop starts here
+    sim = robot.sim
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    viewer = SceneViewer(sim, server)
+    viewer = SceneViewer(robot, server, world=SimWorld(sim))
     stop = threading.Event()
     cap = CaptureStats()
     capture = threading.Thread(
@@ -152,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         viewer.stop()
         if capture.is_alive():
             capture.join(timeout=10)
-        sim.close()
+        robot.close()
         server.stop()
     if cap.error is not None:
         print(f"realtime_factor: capture failed: {cap.error!r}", file=sys.stderr)

@@ -325,6 +325,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from laserpick.console.operator_console import OperatorConsole
     from laserpick.console.viewer import SceneViewer
     from laserpick.robot.sim.robot import SimRobot
+    from laserpick.robot.sim.world_view import SimWorld
     from laserpick.server.app import create_app
     from laserpick.server.session import Session
 
@@ -337,14 +338,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
             host=args.host, port=args.viser_port, label="laserpick", verbose=False
         )
         viewer = SceneViewer(
-            session.robot.sim,
+            session.robot,
             server,
+            world=SimWorld(session.robot.sim),
             rate_hz=args.viewer_rate,
             controls=False,
             lite=args.lite_view,
         )
         viewer.start()
-        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))
+        session.on_scene(lambda robot: viewer.set_robot(robot, SimWorld(robot.sim)))
         console = OperatorConsole(session, server, controls=loopback)
         console.start()
         viser_port = server.get_port()
