@@ -6,6 +6,8 @@ Frames: the session works in `base` (x forward, y left, z up); the scene is draw
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
+
 import numpy as np
 import viser
 
@@ -23,14 +25,21 @@ def to_world(points_base: np.ndarray, base_pose: np.ndarray) -> np.ndarray:
     return points_base @ T[:3, :3].T + T[:3, 3]
 
 
-class OverlayNodes:
-    """The overlays' scene nodes by key ("cloud", "laser", ...), each replaced as a whole."""
+class OverlayNodes(Mapping[str, viser.SceneNodeHandle]):
+    """The overlays' scene nodes by key ("cloud", "lit", "laser", ...), each replaced as a
+    whole; read like a dict."""
 
     def __init__(self) -> None:
         self._nodes: dict[str, viser.SceneNodeHandle] = {}
 
-    def get(self, key: str) -> viser.SceneNodeHandle | None:
-        return self._nodes.get(key)
+    def __getitem__(self, key: str) -> viser.SceneNodeHandle:
+        return self._nodes[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._nodes)
+
+    def __len__(self) -> int:
+        return len(self._nodes)
 
     def pop(self, key: str) -> viser.SceneNodeHandle:
         """Take the node under `key` out of the registry (it stays in the scene)."""

@@ -4,7 +4,7 @@ A real robot knows its own body (drawn from its description, `robot_view`) and w
 sensors see (the fused cloud, drawn by the operator console); it offers no layer. A
 simulator knows the room too: the floor, the furniture and the objects, and it can pause.
 `WorldLayer` is what the view asks of such a layer (the simulator's is
-`laserpick.robot.sim.world_view.SimWorld`, passed in by the CLI); `WorldNodes` draws one.
+`SimWorld`, passed in by the CLI for a simulated robot); `WorldNodes` draws one.
 
 Frames and units: poses in `world` (z up), metres; quaternions (w, x, y, z); RGBA in [0, 1].
 """
