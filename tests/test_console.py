@@ -17,6 +17,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,8 +27,12 @@ from screenshots import pixel_stats
 from serve_process import ServeProcess
 
 from laserpick.client import Client
-from laserpick.console import headless_chromium
+from laserpick.console import SceneViewer, headless_chromium
 from laserpick.console.default_camera import default_view_pixel
+from laserpick.console.scene_nodes import POSE_STEP_M
+from laserpick.robot.sim import SimRobot, load_scene
+from laserpick.robot.sim.world_view import SimWorld
+from laserpick.transforms import matrix_from_quat
 
 REPO = Path(__file__).resolve().parents[1]
 ARTIFACTS = REPO / "test-artifacts"
@@ -73,14 +78,7 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
                 page = browser.new_page(viewport={"width": 900, "height": 600})
                 page.goto(server.viser_url)
                 page.get_by_role("button", name="Detect").wait_for(timeout=30_000)
-                # The scene fades in: poll until the view shows many colours twice running.
-                stats: dict = {}
-                good, t0 = 0, time.monotonic()
-                while time.monotonic() - t0 < 45 and good < 2:
-                    time.sleep(1.0)
-                    stats = pixel_stats(page, page.screenshot())
-                    good = good + 1 if stats["colours"] >= 6 else 0
-                assert stats["colours"] >= 6, f"the view looks blank: {stats}"
+                wait_drawn(page)
 
                 box = page.locator("canvas").first.bounding_box()
                 x, y = default_view_pixel(mug["center_base"], box["width"], box["height"])
@@ -106,34 +104,53 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
             finally:
                 browser.close()
         assert server.proc.poll() is None, "server died while the browser was connected"
-
-        t0 = time.monotonic()
-        server.proc.send_signal(signal.SIGTERM)
-        rc = server.proc.wait(timeout=15)
-        assert rc == 0, server.log()
-        assert time.monotonic() - t0 < 10.0
-        time.sleep(0.2)  # let the reader thread take the last lines
-        assert any("shutting down" in line for line in server.output)
+        assert_sigterm_ends(server)
     finally:
         server.close()
 
 
-def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer() -> None:
-    """The robot is drawn from its description and `Robot.state()`: its parts sit where the
-    simulator has its bodies, and follow the scooter as it drives. The world (floor,
-    furniture, objects) comes from the simulator's layer; without a layer only the robot is
-    drawn. A resting body's creep is not sent; a new robot (scene reset) is drawn anew."""
-    viser = pytest.importorskip("viser")
-    from laserpick.console import SceneViewer
-    from laserpick.console.scene_nodes import POSE_STEP_M
-    from laserpick.robot.sim import SimRobot, load_scene
-    from laserpick.robot.sim.world_view import SimWorld
-    from laserpick.transforms import matrix_from_quat
+def wait_drawn(page) -> None:
+    """Until the view shows many colours twice running (the scene fades in)."""
+    stats: dict = {}
+    good, t0 = 0, time.monotonic()
+    while time.monotonic() - t0 < 45 and good < 2:
+        time.sleep(1.0)
+        stats = pixel_stats(page, page.screenshot())
+        good = good + 1 if stats["colours"] >= 6 else 0
+    assert stats["colours"] >= 6, f"the view looks blank: {stats}"
 
-    robot = SimRobot(load_scene("isolation"), realtime=False)
+
+def assert_sigterm_ends(server: ServeProcess) -> None:
+    """SIGTERM ends the server within 10 s, with exit code 0, saying it shuts down."""
+    t0 = time.monotonic()
+    server.proc.send_signal(signal.SIGTERM)
+    rc = server.proc.wait(timeout=15)
+    assert rc == 0, server.log()
+    assert time.monotonic() - t0 < 10.0
+    time.sleep(0.2)  # let the reader thread take the last lines
+    assert any("shutting down" in line for line in server.output)
+
+
+@pytest.fixture
+def view_server() -> Iterator[object]:
+    """A viser server on a free port, stopped after the test."""
+    viser = pytest.importorskip("viser")
     server = viser.ViserServer(host="127.0.0.1", port=_free_port(), verbose=False)
     try:
-        viewer = SceneViewer(robot, server, world=SimWorld(robot.sim))
+        yield server
+    finally:
+        server.stop()
+
+
+def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer(
+    view_server,
+) -> None:
+    """The robot is drawn from its description and `Robot.state()`: its parts sit where the
+    simulator has its bodies, and follow the scooter as it drives. The world (floor,
+    furniture, objects) comes from the simulator's layer."""
+    robot = SimRobot(load_scene("isolation"), realtime=False)
+    try:
+        viewer = SceneViewer(robot, view_server, world=SimWorld(robot.sim))
         parts, world = viewer.robot_nodes, viewer.world_nodes
         assert {"scooter", "ur5/link1", "gripper", "finger_left"} <= set(parts.parts)
         assert "world" in world.still and "surface/table" in world.still
@@ -144,7 +161,6 @@ def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer(
         root, link3 = parts.root, parts.frame("ur5/link3")
         x0 = float(root.position[0])
         assert not viewer.update(), "no burst without new robot time"
-
         # Reverse at 0.5 m/s for a second (the dead-man is 0.5 s, so re-issue it), then send
         # one update. Reverse: driving forward, the arm's base meets the table's edge.
         for _ in range(4):
@@ -152,23 +168,35 @@ def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer(
             robot.sleep(0.25)
         assert viewer.update()
         snap = robot.sim.snapshot()
-        b = robot.sim.info.scooter_body
         x, y, yaw = snap.base_pose
         np.testing.assert_allclose(root.position, [x, y, 0.0], atol=1e-9)
         np.testing.assert_allclose(root.wxyz, [np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)], atol=1e-9)
         assert -0.6 < float(root.position[0]) - x0 < -0.15
         # A link's frame (in `base`, under the root) is where the simulator has its body
         # (whose pose lags its joints by the step the arm's servo still moves it: 30 um).
+        b = robot.sim.info.scooter_body
         R = matrix_from_quat(snap.xquat[b])
         link = robot.sim.model.body("ur5/link3").id
-        np.testing.assert_allclose(
-            link3.position, R.T @ (snap.xpos[link] - snap.xpos[b]), atol=1e-4
-        )
+        in_base = R.T @ (snap.xpos[link] - snap.xpos[b])
+        np.testing.assert_allclose(link3.position, in_base, atol=1e-4)
         assert viewer.stats.updates == 1
+        viewer.close()
+    finally:
+        robot.close()
 
-        # A resting body's creep is not sent (each pose sent makes the browser draw a frame,
-        # and a click waits behind it): under POSE_STEP_M from the pose last sent, the node
-        # keeps that pose; past it, it follows.
+
+def test_viewer_sends_no_creep_and_redraws_a_new_robot_with_or_without_a_world(
+    view_server,
+) -> None:
+    """A resting body's creep is not sent (each pose sent makes the browser draw a frame,
+    and a click waits behind it): under POSE_STEP_M from the pose last sent, the node keeps
+    that pose; past it, it follows. A new robot (scene reset) is drawn at its start pose; a
+    robot without a world layer is drawn alone, with no run state in the status line."""
+    robot = SimRobot(load_scene("isolation"), realtime=False)
+    robot2 = SimRobot(load_scene("isolation"), realtime=False)
+    try:
+        viewer = SceneViewer(robot, view_server, world=SimWorld(robot.sim))
+        root = viewer.robot_nodes.root
         state = robot.state()
         shown = np.array(root.position)
         creep = state.base_pose + np.array([0.0, 0.4 * POSE_STEP_M, 0.0])
@@ -178,20 +206,17 @@ def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer(
         viewer.update(replace(state, base_pose=creep, stamp=state.stamp + 0.2))
         np.testing.assert_allclose(root.position[:2], creep[:2], atol=1e-6)
 
-        # A new robot (scene reset) is drawn at its start pose; a robot without a world
-        # layer is drawn alone, with no run state in the status line.
-        robot2 = SimRobot(load_scene("isolation"), realtime=False)
         viewer.set_robot(robot2, SimWorld(robot2.sim))
-        assert abs(float(viewer.robot_nodes.root.position[0]) - x0) < 1e-6
+        np.testing.assert_allclose(viewer.robot_nodes.root.position, shown, atol=1e-9)
         status = viewer.status_text()
         assert "time" in status and "running" in status and "e-stop clear" in status
         viewer.set_robot(robot2)
         assert viewer.world_nodes is None and "running" not in viewer.status_text()
+        assert viewer.robot_nodes is not None
         viewer.close()
-        robot2.close()
     finally:
         robot.close()
-        server.stop()
+        robot2.close()
 
 
 def test_a_beam_ends_with_a_dot_where_it_meets_the_cloud() -> None:

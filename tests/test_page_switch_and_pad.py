@@ -212,7 +212,7 @@ def test_esc_stops_and_the_gamepad_and_keys_drive(browser, server: ServeProcess)
         assert x_release < x0 - 0.05, "the dead-man and the stick did not drive"
         # Let go at the page's 0.3 m/s, the base brakes over v^2/2a (7.5 cm); the release's
         # way to the server adds a little. A drive that overtook the stop sent on release
-        # (it happened) would add its 0.5 s at full speed: 15 cm more.
+        # would add its 0.5 s at full speed: 15 cm more.
         braking = 0.3**2 / (2 * dims.BASE_A_MAX)
         coasted = x_release - _at_rest(api)
         assert coasted < braking + 0.075, f"went on {coasted * 100:.1f} cm after the release"

@@ -865,7 +865,7 @@ const softwareGL = (() => {
 // connected to the viser server at viewUrl. "half" draws a quarter of the pixels, without
 // multisampling. Without a GPU a full-detail frame takes 70-85 ms, and while the scene changes
 // the browser spends most of the robot computer's CPU drawing (bench/view_load.py); the
-// multisampling was half of a frame, and a click waits behind frames
+// multisampling is half of a frame, and a click waits behind frames
 // (bench/click_latency.py). So "auto" is half there and full elsewhere.
 function viewSrc() {
   const half = settings.viewDetail === "half" || (settings.viewDetail === "auto" && softwareGL);
