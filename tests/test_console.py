@@ -224,19 +224,14 @@ def test_a_beam_ends_with_a_dot_where_it_meets_the_cloud() -> None:
     ends at the first cloud point it passes, with a dot there, in `world`; with no cloud
     or no point on its way it is drawn 3 m long, without a dot."""
     from laserpick.console.laser_overlay import BEAM_LENGTH, beam_segments
-    from laserpick.types import FusedCloud
 
     # A wall of points at x = 2 m in the cloud's `base`, captured with the scooter at the
     # origin; the scooter has since moved 0.5 m forward.
     ys, zs = np.meshgrid(np.arange(-1, 1, 0.005), np.arange(0, 1.5, 0.005))
     wall = np.c_[np.full(ys.size, 2.0), ys.ravel(), zs.ravel()].astype(np.float32)
-    n = len(wall)
-    cloud = FusedCloud(
-        wall, np.zeros_like(wall), np.zeros(n, np.uint8), np.zeros(n, np.int32), ("c",)
-    )
     beams = [(np.array([0.5, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))]
     pose = np.array([0.5, 0.0, 0.0])
-    segments, dots = beam_segments(beams, pose, (cloud, np.zeros(3)))
+    segments, dots = beam_segments(beams, pose, (wall, np.zeros(3)))
     np.testing.assert_allclose(segments[0, 0], [1.0, 0.0, 1.0])
     assert len(dots) == 1 and abs(dots[0][0] - 2.0) < 1e-9 and abs(dots[0][2] - 1.0) < 0.01
     np.testing.assert_allclose(segments[0, 1], dots[0])
@@ -244,7 +239,7 @@ def test_a_beam_ends_with_a_dot_where_it_meets_the_cloud() -> None:
     assert not dots
     np.testing.assert_allclose(segments[0, 1], [1.0 + BEAM_LENGTH, 0.0, 1.0])
     away = [(np.array([0.5, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0]))]
-    assert not beam_segments(away, pose, (cloud, np.zeros(3)))[1]
+    assert not beam_segments(away, pose, (wall, np.zeros(3)))[1]
 
 
 def test_bad_scene_exits_2_naming_it() -> None:
