@@ -39,8 +39,10 @@ import viser
 from laserpick.console import headless_chromium
 from laserpick.console.viewer import SceneViewer
 from laserpick.robot.sim.loop import Simulation
+from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.sensors import DepthCameras
+from laserpick.robot.sim.world_view import SimWorld
 from laserpick.settings import get_settings
 
 
@@ -127,9 +129,10 @@ def measure(args: argparse.Namespace, width: int, height: int, cap: CaptureStats
     the warm-up, measure for `args.seconds`. An exit code where the browser never connected."""
     from playwright.sync_api import sync_playwright
 
-    sim = Simulation(load_scene(args.scene), realtime=True)
+    robot = SimRobot(load_scene(args.scene), realtime=True)  # its loop starts here
+    sim = robot.sim
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    viewer = SceneViewer(sim, server)
+    viewer = SceneViewer(robot, server, world=SimWorld(sim))
     stop = threading.Event()
     capture = threading.Thread(
         target=capture_loop,
@@ -168,7 +171,7 @@ def measure(args: argparse.Namespace, width: int, height: int, cap: CaptureStats
         viewer.stop()
         if capture.is_alive():
             capture.join(timeout=10)
-        sim.close()
+        robot.close()
         server.stop()
     return Window(
         snap1.time - snap0.time,

@@ -414,15 +414,18 @@ class _ViewServer:
         self.server = viser.ViserServer(
             host=args.host, port=args.viser_port, label="laserpick", verbose=False
         )
+        from laserpick.robot.sim.world_view import SimWorld
+
         viewer = self.viewer = SceneViewer(
-            session.robot.sim,  # type: ignore[attr-defined]
+            session.robot,
             self.server,
+            world=SimWorld(session.robot.sim),  # type: ignore[attr-defined]
             rate_hz=args.viewer_rate,
             controls=False,
             lite=args.lite_view,
         )
         viewer.start()
-        session.on_scene(lambda robot: viewer.set_simulation(robot.sim))  # type: ignore[attr-defined]
+        session.on_scene(lambda robot: viewer.set_robot(robot, SimWorld(robot.sim)))  # type: ignore[attr-defined]
         self.console = OperatorConsole(session, self.server, controls=loopback)
         self.console.start()
         port = self.server.get_port()

@@ -4,7 +4,8 @@
    renders, a click on an object aims and a second confirms the mark, the lit target and the
    grasp outlines show, STOP latches the e-stop, and SIGTERM ends the server cleanly. The
    screenshot: test-artifacts/console.png.
-2. The viewer's moving-body nodes follow the simulation (headless sim, one update by hand).
+2. The viewer draws the robot from its description and state, and the simulator's world as
+   a layer (headless sim, one update by hand); the laser's beams end on the cloud.
 3. Bad scene names and non-loopback hosts are refused with exit code 2 and a reason.
 """
 
@@ -16,6 +17,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -25,8 +27,12 @@ from screenshots import pixel_stats
 from serve_process import ServeProcess
 
 from laserpick.client import Client
-from laserpick.console import headless_chromium
-from laserpick.console.viewer import default_view_pixel
+from laserpick.console import SceneViewer, headless_chromium
+from laserpick.console.default_camera import default_view_pixel
+from laserpick.console.scene_nodes import POSE_STEP_M
+from laserpick.robot.sim import SimRobot, load_scene
+from laserpick.robot.sim.world_view import SimWorld
+from laserpick.transforms import matrix_from_quat
 
 REPO = Path(__file__).resolve().parents[1]
 ARTIFACTS = REPO / "test-artifacts"
@@ -72,14 +78,7 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
                 page = browser.new_page(viewport={"width": 900, "height": 600})
                 page.goto(server.viser_url)
                 page.get_by_role("button", name="Detect").wait_for(timeout=30_000)
-                # The scene fades in: poll until the view shows many colours twice running.
-                stats: dict = {}
-                good, t0 = 0, time.monotonic()
-                while time.monotonic() - t0 < 45 and good < 2:
-                    time.sleep(1.0)
-                    stats = pixel_stats(page, page.screenshot())
-                    good = good + 1 if stats["colours"] >= 6 else 0
-                assert stats["colours"] >= 6, f"the view looks blank: {stats}"
+                wait_drawn(page)
 
                 box = page.locator("canvas").first.bounding_box()
                 x, y = default_view_pixel(mug["center_base"], box["width"], box["height"])
@@ -105,85 +104,142 @@ def test_console_renders_aims_by_click_shows_the_lit_target_and_stops(tmp_path: 
             finally:
                 browser.close()
         assert server.proc.poll() is None, "server died while the browser was connected"
-
-        t0 = time.monotonic()
-        server.proc.send_signal(signal.SIGTERM)
-        rc = server.proc.wait(timeout=15)
-        assert rc == 0, server.log()
-        assert time.monotonic() - t0 < 10.0
-        time.sleep(0.2)  # let the reader thread take the last lines
-        assert any("shutting down" in line for line in server.output)
+        assert_sigterm_ends(server)
     finally:
         server.close()
 
 
-def test_viewer_nodes_follow_the_sim() -> None:
-    viser = pytest.importorskip("viser")
-    from laserpick.console.viewer import SceneViewer
-    from laserpick.robot.sim.loop import Simulation
-    from laserpick.robot.sim.scenes import load_scene
+def wait_drawn(page) -> None:
+    """Until the view shows many colours twice running (the scene fades in)."""
+    stats: dict = {}
+    good, t0 = 0, time.monotonic()
+    while time.monotonic() - t0 < 45 and good < 2:
+        time.sleep(1.0)
+        stats = pixel_stats(page, page.screenshot())
+        good = good + 1 if stats["colours"] >= 6 else 0
+    assert stats["colours"] >= 6, f"the view looks blank: {stats}"
 
-    sim = Simulation(load_scene("isolation"), realtime=False)
+
+def assert_sigterm_ends(server: ServeProcess) -> None:
+    """SIGTERM ends the server within 10 s, with exit code 0, saying it shuts down."""
+    t0 = time.monotonic()
+    server.proc.send_signal(signal.SIGTERM)
+    rc = server.proc.wait(timeout=15)
+    assert rc == 0, server.log()
+    assert time.monotonic() - t0 < 10.0
+    time.sleep(0.2)  # let the reader thread take the last lines
+    assert any("shutting down" in line for line in server.output)
+
+
+@pytest.fixture
+def view_server() -> Iterator[object]:
+    """A viser server on a free port, stopped after the test."""
+    viser = pytest.importorskip("viser")
     server = viser.ViserServer(host="127.0.0.1", port=_free_port(), verbose=False)
     try:
-        viewer = SceneViewer(sim, server)
-        assert "scooter" in viewer.moving_bodies
-        assert "ur5/link1" in viewer.moving_bodies
-        assert "finger_left" in viewer.moving_bodies
-        assert "world" in viewer.static_bodies
-        assert not set(viewer.moving_bodies) & set(viewer.static_bodies)
-        # The flange carries only a site (group 5): nothing to draw.
-        assert "ur5/flange" not in viewer.moving_bodies
-        info = sim.info
-        for name in info.object_bodies:
-            assert f"obj/{name}" in viewer.moving_bodies
-
-        scooter = viewer.body_handle("scooter")
-        link1 = viewer.body_handle("ur5/link1")
-        x0 = float(scooter.position[0])
-        link1_0 = np.array(link1.position)
-        assert not viewer.update(), "no burst without new sim time"
-
-        # Reverse at 0.5 m/s for a second of sim time (the dead-man is 0.5 s, so re-issue
-        # it), then send one update. Reverse: driving forward, the arm's base meets the
-        # isolation table's edge after about 0.1 m.
-        for _ in range(4):
-            sim.drive(-0.5, 0.0, 0.5)
-            sim.settle(0.25)
-        assert viewer.update()
-        snap = sim.snapshot()
-        b = info.scooter_body
-        np.testing.assert_allclose(scooter.position, snap.xpos[b], atol=1e-6)
-        np.testing.assert_allclose(np.abs(scooter.wxyz @ snap.xquat[b]), 1.0, atol=1e-6)
-        moved = float(scooter.position[0]) - x0
-        assert -0.6 < moved < -0.15, f"scooter node moved {moved:.3f} m"
-        # The arm rides along.
-        assert np.linalg.norm(np.array(link1.position) - link1_0) > 0.1
-        assert viewer.stats.updates == 1
-
-        # A resting body's creep is not sent (each pose sent makes the browser draw a frame,
-        # and a click waits behind it): under POSE_STEP_M from the pose last sent, the node
-        # keeps that pose; past it, it follows.
-        from laserpick.console.viewer import POSE_STEP_M
-
-        shown = np.array(scooter.position)
-        creep = snap.xpos.copy()
-        creep[b, 1] += 0.4 * POSE_STEP_M
-        viewer.update(replace(snap, xpos=creep, time=snap.time + 0.1))
-        np.testing.assert_allclose(scooter.position, shown, atol=1e-9)
-        creep[b, 1] += 2.0 * POSE_STEP_M
-        viewer.update(replace(snap, xpos=creep, time=snap.time + 0.2))
-        np.testing.assert_allclose(scooter.position, creep[b], atol=1e-6)
-
-        # A new simulation (scene reset) rebuilds the nodes at the start pose.
-        sim2 = Simulation(load_scene("isolation"), realtime=False)
-        viewer.set_simulation(sim2)
-        assert abs(float(viewer.body_handle("scooter").position[0]) - x0) < 1e-6
-        status = viewer.status_text()
-        assert "sim time" in status and "e-stop clear" in status
-        viewer.close()
+        yield server
     finally:
         server.stop()
+
+
+def test_viewer_draws_the_robot_from_its_state_and_the_world_from_the_sim_layer(
+    view_server,
+) -> None:
+    """The robot is drawn from its description and `Robot.state()`: its parts sit where the
+    simulator has its bodies, and follow the scooter as it drives. The world (floor,
+    furniture, objects) comes from the simulator's layer."""
+    robot = SimRobot(load_scene("isolation"), realtime=False)
+    try:
+        viewer = SceneViewer(robot, view_server, world=SimWorld(robot.sim))
+        parts, world = viewer.robot_nodes, viewer.world_nodes
+        assert {"scooter", "ur5/link1", "gripper", "finger_left"} <= set(parts.parts)
+        assert "world" in world.still and "surface/table" in world.still
+        for name in robot.sim.info.object_bodies:
+            assert f"obj/{name}" in world.moving
+        assert not {"scooter", "ur5/link1", "gripper"} & {*world.moving, *world.still}
+
+        root, link3 = parts.root, parts.frame("ur5/link3")
+        x0 = float(root.position[0])
+        assert not viewer.update(), "no burst without new robot time"
+        # Reverse at 0.5 m/s for a second (the dead-man is 0.5 s, so re-issue it), then send
+        # one update. Reverse: driving forward, the arm's base meets the table's edge.
+        for _ in range(4):
+            robot.drive(-0.5, 0.0, 0.5)
+            robot.sleep(0.25)
+        assert viewer.update()
+        snap = robot.sim.snapshot()
+        x, y, yaw = snap.base_pose
+        np.testing.assert_allclose(root.position, [x, y, 0.0], atol=1e-9)
+        np.testing.assert_allclose(root.wxyz, [np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)], atol=1e-9)
+        assert -0.6 < float(root.position[0]) - x0 < -0.15
+        # A link's frame (in `base`, under the root) is where the simulator has its body
+        # (whose pose lags its joints by the step the arm's servo still moves it: 30 um).
+        b = robot.sim.info.scooter_body
+        R = matrix_from_quat(snap.xquat[b])
+        link = robot.sim.model.body("ur5/link3").id
+        in_base = R.T @ (snap.xpos[link] - snap.xpos[b])
+        np.testing.assert_allclose(link3.position, in_base, atol=1e-4)
+        assert viewer.stats.updates == 1
+        viewer.close()
+    finally:
+        robot.close()
+
+
+def test_viewer_sends_no_creep_and_redraws_a_new_robot_with_or_without_a_world(
+    view_server,
+) -> None:
+    """A resting body's creep is not sent (each pose sent makes the browser draw a frame,
+    and a click waits behind it): under POSE_STEP_M from the pose last sent, the node keeps
+    that pose; past it, it follows. A new robot (scene reset) is drawn at its start pose; a
+    robot without a world layer is drawn alone, with no run state in the status line."""
+    robot = SimRobot(load_scene("isolation"), realtime=False)
+    robot2 = SimRobot(load_scene("isolation"), realtime=False)
+    try:
+        viewer = SceneViewer(robot, view_server, world=SimWorld(robot.sim))
+        root = viewer.robot_nodes.root
+        state = robot.state()
+        shown = np.array(root.position)
+        creep = state.base_pose + np.array([0.0, 0.4 * POSE_STEP_M, 0.0])
+        viewer.update(replace(state, base_pose=creep, stamp=state.stamp + 0.1))
+        np.testing.assert_allclose(root.position, shown, atol=1e-9)
+        creep = creep + np.array([0.0, 2.0 * POSE_STEP_M, 0.0])
+        viewer.update(replace(state, base_pose=creep, stamp=state.stamp + 0.2))
+        np.testing.assert_allclose(root.position[:2], creep[:2], atol=1e-6)
+
+        viewer.set_robot(robot2, SimWorld(robot2.sim))
+        np.testing.assert_allclose(viewer.robot_nodes.root.position, shown, atol=1e-9)
+        status = viewer.status_text()
+        assert "time" in status and "running" in status and "e-stop clear" in status
+        viewer.set_robot(robot2)
+        assert viewer.world_nodes is None and "running" not in viewer.status_text()
+        assert viewer.robot_nodes is not None
+        viewer.close()
+    finally:
+        robot.close()
+        robot2.close()
+
+
+def test_a_beam_ends_with_a_dot_where_it_meets_the_cloud() -> None:
+    """The laser is drawn from what a real robot knows: its beams and the fused cloud. A beam
+    ends at the first cloud point it passes, with a dot there, in `world`; with no cloud
+    or no point on its way it is drawn 3 m long, without a dot."""
+    from laserpick.console.laser_overlay import BEAM_LENGTH, beam_segments
+
+    # A wall of points at x = 2 m in the cloud's `base`, captured with the scooter at the
+    # origin; the scooter has since moved 0.5 m forward.
+    ys, zs = np.meshgrid(np.arange(-1, 1, 0.005), np.arange(0, 1.5, 0.005))
+    wall = np.c_[np.full(ys.size, 2.0), ys.ravel(), zs.ravel()].astype(np.float32)
+    beams = [(np.array([0.5, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))]
+    pose = np.array([0.5, 0.0, 0.0])
+    segments, dots = beam_segments(beams, pose, (wall, np.zeros(3)))
+    np.testing.assert_allclose(segments[0, 0], [1.0, 0.0, 1.0])
+    assert len(dots) == 1 and abs(dots[0][0] - 2.0) < 1e-9 and abs(dots[0][2] - 1.0) < 0.01
+    np.testing.assert_allclose(segments[0, 1], dots[0])
+    segments, dots = beam_segments(beams, pose, None)
+    assert not dots
+    np.testing.assert_allclose(segments[0, 1], [1.0 + BEAM_LENGTH, 0.0, 1.0])
+    away = [(np.array([0.5, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0]))]
+    assert not beam_segments(away, pose, (wall, np.zeros(3)))[1]
 
 
 def test_bad_scene_exits_2_naming_it() -> None:
@@ -219,7 +275,7 @@ def test_lit_points_are_looked_up_by_their_projector_pixel() -> None:
     """The lit points are those whose projector pixel (computed once per cloud) the image
     lights: a point on the axis of a lit pixel is lit, one beside it, one behind the lens or
     one outside the image is not."""
-    from laserpick.console.operator_console import lit_by, projector_pixels
+    from laserpick.console import lit_by, projector_pixels
     from laserpick.pipeline.projector import projector_intrinsics
     from laserpick.types import Projector
 

@@ -121,8 +121,8 @@ def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> 
         _wait(lambda: session.foreseen is not None)
         cloud, image = session.foreseen
         assert cloud is session.latest_cloud[0] and image.any()
-        _wait(lambda: any(k.startswith("lit-") for k in console._drawn.nodes))
-        (ahead,) = [h for k, h in console._drawn.nodes.items() if k.startswith("lit-")]
+        _wait(lambda: any(k.startswith("lit-") for k in console.nodes))
+        (ahead,) = [h for k, h in console.nodes.items() if k.startswith("lit-")]
         assert not ahead.visible
         foreseen = session.foreseen_mark
         session.confirm(actor, point=centre[0])
@@ -130,7 +130,7 @@ def test_a_clicked_mark_is_worked_out_before_its_confirm_and_shown_at_once() -> 
         _wait(lambda: not session.busy and session.state != TaskState.MARKED)
         assert session.task.perception is foreseen.perception
         assert session.projection is image
-        _wait(lambda: console._drawn.nodes.get("lit") is ahead)
+        _wait(lambda: console.nodes.get("lit") is ahead)
         assert ahead.visible
         # Aimed there again in the same capture: nothing new to work out. Confirmed
         # elsewhere: worked out anew, in the same capture.

@@ -18,11 +18,13 @@ const $ = (id) => document.getElementById(id);
 // Robot states in which the laser may be aimed (the server's AIMABLE).
 const AIMABLE = new Set(["idle", "aiming", "perceived", "grasps_ready", "holding", "awaiting_place"]);
 const FINE_STEP = 0.01;   // rad: Shift+arrow
-const MAX_NUDGE = 0.2;    // rad: the server's largest nudge per command
 const DRIVE_PERIOD = 250; // ms: a drive command is a 0.5 s dead-man, so resend at 4 Hz
 const PAD_RATE = 0.5;     // rad/s: the laser's turn rate at full stick
 const PAD_DEAD = 0.2;     // stick dead zone (of full travel)
 const PAD_DEADMAN = 5;    // RB, standard mapping: hold for any drive motion
+// rad: the server's largest nudge per command, from GET /health; null until the server says
+// (a server that does not say is not second-guessed here).
+let maxNudge = null;
 
 // --- settings, remembered per user in this browser (localStorage) -------------------------
 
@@ -426,7 +428,7 @@ function nudge(dyaw, dpitch) {
 }
 async function flushNudge() {
   if (pending.busy || (Math.abs(pending.dyaw) < 1e-4 && Math.abs(pending.dpitch) < 1e-4)) return;
-  const clamp = (v) => Math.max(-MAX_NUDGE, Math.min(MAX_NUDGE, v));
+  const clamp = (v) => (maxNudge === null ? v : Math.max(-maxNudge, Math.min(maxNudge, v)));
   const dyaw = clamp(pending.dyaw), dpitch = clamp(pending.dpitch);
   pending.dyaw -= dyaw;
   pending.dpitch -= dpitch;
@@ -863,7 +865,7 @@ const softwareGL = (() => {
 // connected to the viser server at viewUrl. "half" draws a quarter of the pixels, without
 // multisampling. Without a GPU a full-detail frame takes 70-85 ms, and while the scene changes
 // the browser spends most of the robot computer's CPU drawing (bench/view_load.py); the
-// multisampling was half of a frame, and a click waits behind frames
+// multisampling is half of a frame, and a click waits behind frames
 // (bench/click_latency.py). So "auto" is half there and full elsewhere.
 function viewSrc() {
   const half = settings.viewDetail === "half" || (settings.viewDetail === "auto" && softwareGL);
@@ -893,6 +895,7 @@ function showView(on) {
 async function findView() {
   try {
     const h = await (await fetch(`${API}/health`)).json();
+    if (typeof h.max_nudge === "number" && h.max_nudge > 0) maxNudge = h.max_nudge;
     if (h.viser_url) viewUrl = new URL(h.viser_url, location.href).href;
     else if (h.viser_port) viewUrl = `${location.protocol}//${location.hostname}:${h.viser_port}/`;
   } catch { /* retried below */ }
