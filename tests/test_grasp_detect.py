@@ -10,9 +10,26 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
-from laserpick.pipeline import grasp_detect as gd
-from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.gpd import CandidateSearch, detect_grasps
+from laserpick.pipeline.gpd.antipodal import (
+    antipodal_possible,
+    closing_region,
+    guesses_face_seen,
+    pad_pairs,
+)
+from laserpick.pipeline.gpd.closing_grid import ClosingGrid, deepest_tips, middle_placement
+from laserpick.pipeline.gpd.frames import (
+    local_frames,
+    orientation_angles,
+    sample_indices,
+    tilted_frames,
+)
+from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
+from laserpick.pipeline.gpd.neighbourhoods import slab_pairs
+from laserpick.pipeline.gpd.recentre import patch_moves
+from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, RangeMax, VoxelGroups, pruned_tips
 from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 
@@ -200,17 +217,17 @@ def test_off_centre_hands_are_turned_and_shifted_onto_their_patch():
     would meet the can along their face."""
     pts, n = cylinder(r=0.033, height=0.122)
     normals, scene = noisy(n), np.vstack([table(), pts]).astype(np.float32)
-    s = gd.cleared_hand(S)
+    s = cleared_hand(S)
     centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     tgt = pts - centre
-    tree = gd.cKDTree(tgt)
-    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(0))
-    normal, axis = gd.local_frames(tgt, normals, idx, s, tree)
-    hands = gd.Hands(tgt, normals, scene, centre, tree, s, None, lambda _: None)
-    found = hands.grasps(tgt[idx], normal, axis)
+    tree = cKDTree(tgt)
+    idx = sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(0))
+    normal, axis = local_frames(tgt, normals, idx, s, tree)
+    search = CandidateSearch(tgt, normals, scene, centre, tree, s, None, lambda _: None)
+    found = search.candidates(tgt[idx], normal, axis)
     above = np.flatnonzero(~found.centred & (found.poses[:, 2, 2] < -0.9))
     off = found.subset(above)
-    turn, shift = gd.patch_moves(hands, off)
+    turn, shift = patch_moves(tgt, normals, s, off)
     moved = np.isfinite(shift)
     assert moved.mean() > 0.8
     # The turn levels the closing axis: it turns it by about as much as it leans.
@@ -246,7 +263,7 @@ def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():
     axis = np.cross(normal, rng.normal(size=(5, 3)))
     axis /= np.linalg.norm(axis, axis=1, keepdims=True)
     tilts = np.radians([0.0, 30.0, -60.0])
-    n2, a2 = gd.tilted_frames(normal, axis, tilts)
+    n2, a2 = tilted_frames(normal, axis, tilts)
     assert n2.shape == a2.shape == (15, 3)
     for t, beta in enumerate(tilts):
         rows = slice(5 * t, 5 * t + 5)
@@ -345,14 +362,14 @@ def test_a_pad_on_guessed_points_only_must_face_the_seen_ones():
     guessed = np.array([0, 1, 0, 1, 0, 0, 1, 1], bool)
     contacts = [(f, side, depth, guessed)]
     wider = [(np.array([0]), np.array([0]), np.array([0.010], np.float32), np.array([False]))]
-    ok = gd.guesses_face_seen(contacts + wider, 4)
+    ok = guesses_face_seen(contacts + wider, 4)
     # 0: the guessed pad (-4 mm) lies in front of the seen one (4-10 mm): refused.
     # 1: the guessed pad at 2 mm, the seen one at 4 mm: no overlap, refused; with the seen
     #    pad reaching 2 mm it is kept. 2: both seen: the rule does not apply.
     # 3: both pads guessed: nothing seen is held, refused.
     np.testing.assert_array_equal(ok, [False, False, True, False])
     reach = [(np.array([1]), np.array([0]), np.array([0.002], np.float32), np.array([False]))]
-    assert gd.guesses_face_seen(contacts + reach, 4)[1]
+    assert guesses_face_seen(contacts + reach, 4)[1]
 
 
 def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
@@ -460,9 +477,9 @@ def test_tiny_target_gives_nothing():
 
 def local_setup(target: np.ndarray, normals: np.ndarray, n_samples: int, seed: int = 1):
     """Samples, their frames, orientations and closing grid, as detect_grasps builds them."""
-    idx = gd.sample_indices(len(target), n_samples, np.random.default_rng(seed))
-    normal, axis = gd.local_frames(target, normals, idx, S)
-    return target[idx], normal, axis, gd.orientation_angles(S.gpd_orientations), gd.ClosingGrid(S)
+    idx = sample_indices(len(target), n_samples, np.random.default_rng(seed))
+    normal, axis = local_frames(target, normals, idx, S)
+    return target[idx], normal, axis, orientation_angles(S.gpd_orientations), ClosingGrid(S)
 
 
 def test_pruned_tips_equal_the_direct_computation():
@@ -470,12 +487,12 @@ def test_pruned_tips_equal_the_direct_computation():
     other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
     cloud = np.vstack([table(), other, pts])
     samples, normal, axis, angles, grid = local_setup(pts, noisy(n), 120)
-    regions = gd.hand_regions(S)
-    sid, _, h, u, v = gd.slab_pairs(cloud, samples, normal, axis, regions)
-    direct = gd.deepest_tips(h, u, v, sid, len(samples), angles, grid, S)
+    regions = hand_regions(S)
+    sid, _, h, u, v = slab_pairs(cloud, samples, normal, axis, regions)
+    direct = deepest_tips(h, u, v, sid, len(samples), angles, grid, S)
     want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
-    pairs = gd.CoarsePairs(cloud, samples, normal, axis, regions)
-    pruned = gd.pruned_tips(pairs, samples, normal, axis, angles, grid, S, regions, want)
+    pairs = CoarsePairs(cloud, samples, normal, axis, regions)
+    pruned = pruned_tips(pairs, samples, normal, axis, angles, grid, S, regions, want)
     free = np.isfinite(direct) & want[:, :, None]
     assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur
     np.testing.assert_array_equal(np.isfinite(pruned), free)
@@ -486,14 +503,14 @@ def test_antipodal_possible_never_rules_out_a_passing_frame():
     pts, n = cylinder()
     normals = noisy(n)
     samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, _, h, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
-    possible = gd.antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
+    sid, _, h, u, v, nu, nv = pad_pairs(pts, normals, samples, normal, axis, S)
+    possible = antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
     rng = np.random.default_rng(3)
     passed = np.zeros(len(possible), bool)
     for _ in range(30):  # any placement, any depth the collision test could give
         offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
         tip = rng.uniform(S.gpd_init_bite, S.finger_length - S.gpd_clearance, len(possible))
-        _, ok, _ = gd.closing_region(
+        _, ok, _ = closing_region(
             h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
         )
         passed |= ok
@@ -505,7 +522,7 @@ def test_range_max_matches_a_direct_max():
     rng = np.random.default_rng(0)
     table_ = rng.normal(size=(37, 5)).astype(np.float32)
     widest = 9
-    range_max = gd.RangeMax(table_, widest)
+    range_max = RangeMax(table_, widest)
     lo = rng.integers(0, 37, 2000)
     hi = np.minimum(lo + rng.integers(0, widest, 2000), 36)
     col = rng.integers(0, 5, 2000)
@@ -515,7 +532,7 @@ def test_range_max_matches_a_direct_max():
 
 def test_voxel_groups_hold_each_point_once_within_its_radius():
     pts = np.random.default_rng(0).uniform(-0.1, 0.1, (5000, 3))
-    vox = gd.VoxelGroups(pts, 0.01)
+    vox = VoxelGroups(pts, 0.01)
     parent, members = vox.members(np.arange(len(vox.starts)))
     np.testing.assert_array_equal(np.sort(members), np.arange(len(pts)))
     for axis in range(3):  # each group fits in one 1 cm cube
@@ -538,25 +555,25 @@ def test_detector_equals_the_direct_computation():
     scene = np.vstack([table(), pts, other]).astype(np.float32)
     fast = detect_grasps(target, normals, scene, given, np.random.default_rng(5))
 
-    s = gd.cleared_hand(given)  # the hand the detector tests
+    s = cleared_hand(given)  # the hand the detector tests
 
     centre = 0.5 * (target.min(axis=0) + target.max(axis=0))
     tgt = target - centre
-    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(5))
-    normal, axis = gd.local_frames(tgt, normals, idx, s)
-    angles, grid = gd.orientation_angles(s.gpd_orientations), gd.ClosingGrid(s)
+    idx = sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(5))
+    normal, axis = local_frames(tgt, normals, idx, s)
+    angles, grid = orientation_angles(s.gpd_orientations), ClosingGrid(s)
     cloud = np.vstack([scene - centre, tgt])
-    sid, _, h, u, v = gd.slab_pairs(cloud, tgt[idx], normal, axis, gd.hand_regions(s))
-    tips = gd.deepest_tips(h, u, v, sid, len(idx), angles, grid, s).reshape(-1, len(grid.offsets))
-    has, k = gd.middle_placement(np.isfinite(tips))
+    sid, _, h, u, v = slab_pairs(cloud, tgt[idx], normal, axis, hand_regions(s))
+    tips = deepest_tips(h, u, v, sid, len(idx), angles, grid, s).reshape(-1, len(grid.offsets))
+    has, k = middle_placement(np.isfinite(tips))
     offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
     tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, _, th, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
-    width, ok, centred = gd.closing_region(
+    tsid, _, th, tu, tv, nu, nv = pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
+    width, ok, centred = closing_region(
         th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s
     )
     good = np.flatnonzero(ok & has)
-    poses = gd.grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
+    poses = grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
     poses[:, :3, 3] += centre
 
     assert len(fast) == len(good) > 50

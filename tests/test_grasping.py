@@ -8,7 +8,7 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.gpd import detect_grasps
 from laserpick.pipeline.grasping import GraspSet, find_grasps, vertical_grasp
 from laserpick.pipeline.perceive import Perception
 from laserpick.settings import get_settings

@@ -40,7 +40,7 @@ from laserpick.pipeline.collision import (
     object_middle,
 )
 from laserpick.pipeline.free_space import beyond_view, fingers_seen_free
-from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.gpd import detect_grasps
 from laserpick.pipeline.overhead import overhead_grasp
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.plan import PickPlan, Searches, plan_pick

@@ -151,14 +151,14 @@ class GraspSettings(BaseModel):
         lt=90,
         description="A pad meets the object along its face where the object's normals at the"
         " pad's extreme lie within this angle (deg) of the closing axis"
-        " (grasp_detect.closing_region). Ours.",
+        " (gpd.antipodal.closing_region). Ours.",
     )
     gpd_patch_offset: float = Field(
         0.007,
         ge=0,
         description="How far (m) along the hand axis the middle of the patch where a pad meets"
         " the object may lie from the pad's middle for the grasp to count as centred"
-        " (grasp_detect.closing_region), and be offered before those that do not"
+        " (gpd.antipodal.closing_region), and be offered before those that do not"
         " (selection.group): a pad that meets it only at its edge lets it spin out. Ours.",
     )
     gpd_recentre: float = Field(
@@ -167,7 +167,7 @@ class GraspSettings(BaseModel):
         description="How far (m) past each side of the pads a hand that is not centred"
         " (gpd_patch_offset) looks for where its pads would meet the object along their face;"
         " it is tried again turned about its axis and moved along it onto that patch"
-        " (grasp_detect.patch_moves). 0 turns this off. Ours: one pad width.",
+        " (gpd.recentre.patch_moves). 0 turns this off. Ours: one pad width.",
     )
     gpd_collision_voxel: float = Field(
         0.0,
