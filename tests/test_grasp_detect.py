@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from laserpick.description.dims import GRIPPER_HAND
 from laserpick.pipeline.gpd import CandidateSearch, detect_grasps
 from laserpick.pipeline.gpd.antipodal import (
     antipodal_possible,
@@ -34,6 +35,7 @@ from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 
 S = GraspSettings()
+HAND = GRIPPER_HAND
 SPACING = 0.003  #: m between object points
 FRICTION = math.radians(S.gpd_friction_deg)
 
@@ -106,7 +108,7 @@ def detect(target, normals, others=(), seed=0, settings=S) -> list[Grasp]:
 def hand_coords(g: Grasp, pts: np.ndarray) -> np.ndarray:
     """Points in the grasp's frame (hand axis, closing, approach), origin at the fingertips'
     centre line (the TCP moved pad_depth / 2 forward)."""
-    tips = g.position + g.approach * S.pad_depth / 2
+    tips = g.position + g.approach * HAND.pad_depth / 2
     return (pts - tips) @ g.pose[:3, :3]
 
 
@@ -114,31 +116,33 @@ def in_fingers(g: Grasp, pts: np.ndarray, grow: float = 0.0) -> np.ndarray:
     """Mask of points inside either finger box (pad plus plate) of the open hand, each box
     grown by `grow` (m) on its four sides (not at the tip or the root)."""
     h, c, a = hand_coords(g, pts).T
-    thick = S.pad_thickness + S.finger_thickness
-    lateral = (np.abs(c) >= S.width_max / 2 - grow) & (np.abs(c) <= S.width_max / 2 + thick + grow)
-    across = np.abs(h) <= S.finger_width / 2 + grow
-    return lateral & across & (a <= 0) & (a >= -S.finger_length)
+    thick = HAND.pad_thickness + HAND.finger_thickness
+    lateral = (np.abs(c) >= HAND.width_max / 2 - grow) & (
+        np.abs(c) <= HAND.width_max / 2 + thick + grow
+    )
+    across = np.abs(h) <= HAND.finger_width / 2 + grow
+    return lateral & across & (a <= 0) & (a >= -HAND.finger_length)
 
 
 def in_palm(g: Grasp, pts: np.ndarray, grow: float = 0.0) -> np.ndarray:
     """Mask of points inside the palm box, grown by `grow` (m) on its four sides."""
     h, c, a = hand_coords(g, pts).T
     return (
-        (np.abs(c) <= S.palm_width / 2 + grow)
-        & (np.abs(h) <= S.palm_depth / 2 + grow)
-        & (a <= -S.finger_length)
-        & (a >= -S.finger_length - S.palm_length)
+        (np.abs(c) <= HAND.palm_width / 2 + grow)
+        & (np.abs(h) <= HAND.palm_depth / 2 + grow)
+        & (a <= -HAND.finger_length)
+        & (a >= -HAND.finger_length - HAND.palm_length)
     )
 
 
 def finger_corners(g: Grasp) -> np.ndarray:
     """The 16 corners of both finger boxes in `base`."""
-    thick = S.pad_thickness + S.finger_thickness
-    tips = g.position + g.approach * S.pad_depth / 2
+    thick = HAND.pad_thickness + HAND.finger_thickness
+    tips = g.position + g.approach * HAND.pad_depth / 2
     out = []
-    for h in (-S.finger_width / 2, S.finger_width / 2):
-        for c in (S.width_max / 2 + thick, -S.width_max / 2 - thick):
-            for a in (0.0, -S.finger_length):
+    for h in (-HAND.finger_width / 2, HAND.finger_width / 2):
+        for c in (HAND.width_max / 2 + thick, -HAND.width_max / 2 - thick):
+            for a in (0.0, -HAND.finger_length):
                 out.append(tips + h * g.axis + c * g.closing + a * g.approach)
     return np.array(out)
 
@@ -161,7 +165,7 @@ def test_cylinder_has_grasps_closing_horizontally_through_its_axis(cylinder_gras
         assert abs(g.closing[2]) <= math.sin(FRICTION + math.radians(3))
         c = g.closing[:2] / np.linalg.norm(g.closing[:2])
         p = g.position[:2]
-        near = 0.03 * math.sin(FRICTION) + S.pad_width / 2
+        near = 0.03 * math.sin(FRICTION) + HAND.pad_width / 2
         assert abs(p[0] * c[1] - p[1] * c[0]) < near
 
 
@@ -170,7 +174,7 @@ def test_cylinder_width_is_its_diameter(cylinder_grasps):
     assert np.median(widths) == pytest.approx(0.06, abs=0.005)
     level = [g.width for g in cylinder_grasps if abs(g.closing[2]) < math.sin(math.radians(5))]
     assert level and np.allclose(level, 0.06, atol=0.005)
-    assert widths.max() <= S.width_max
+    assert widths.max() <= HAND.width_max
 
 
 def test_cylinder_grasps_stay_above_the_table(cylinder_grasps):
@@ -217,17 +221,17 @@ def test_off_centre_hands_are_turned_and_shifted_onto_their_patch():
     would meet the can along their face."""
     pts, n = cylinder(r=0.033, height=0.122)
     normals, scene = noisy(n), np.vstack([table(), pts]).astype(np.float32)
-    s = cleared_hand(S)
+    hand = cleared_hand(HAND, S.side_clearance)
     centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     tgt = pts - centre
     tree = cKDTree(tgt)
-    idx = sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(0))
-    normal, axis = local_frames(tgt, normals, idx, s, tree)
-    search = CandidateSearch(tgt, normals, scene, centre, tree, s, None, lambda _: None)
+    idx = sample_indices(len(tgt), S.gpd_samples, np.random.default_rng(0))
+    normal, axis = local_frames(tgt, normals, idx, S, tree)
+    search = CandidateSearch(tgt, normals, scene, centre, tree, hand, S, None, lambda _: None)
     found = search.candidates(tgt[idx], normal, axis)
     above = np.flatnonzero(~found.centred & (found.poses[:, 2, 2] < -0.9))
     off = found.subset(above)
-    turn, shift = patch_moves(tgt, normals, s, off)
+    turn, shift = patch_moves(tgt, normals, hand, S, off)
     moved = np.isfinite(shift)
     assert moved.mean() > 0.8
     # The turn levels the closing axis: it turns it by about as much as it leans.
@@ -307,7 +311,7 @@ def test_narrow_box_closes_across_its_small_faces():
     for g in grasps:
         # Across the 3 cm or the 5 cm faces (width up to the friction cone's slant), never
         # across the 10 cm height.
-        assert g.width <= S.width_max
+        assert g.width <= HAND.width_max
         assert min(abs(g.width - 0.03), abs(g.width - 0.05)) < 0.012
         assert abs(g.closing[2]) < 0.5
     widths = np.array([g.width for g in grasps])
@@ -317,7 +321,7 @@ def test_narrow_box_closes_across_its_small_faces():
 def test_wide_box_has_no_grasp_wider_than_the_hand():
     pts, n = box((0.12, 0.12, 0.12))
     grasps = detect(pts, n)
-    assert all(0 < g.width <= S.width_max for g in grasps)
+    assert all(0 < g.width <= HAND.width_max for g in grasps)
     # Across any face it is 12 cm: nothing may close there.
     for g in grasps:
         assert np.max(np.abs(g.closing)) < math.cos(FRICTION)
@@ -391,8 +395,8 @@ def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
         """Whether the pads' seen and guessed points overlap in depth (the plates are flat:
         every point between the pads is a contact)."""
         h, c, a = hand_coords(g, pts).T
-        pad = (np.abs(h) < S.pad_width / 2) & (a <= 0) & (a >= -S.pad_depth)
-        pad &= np.abs(c) < S.width_max / 2
+        pad = (np.abs(h) < HAND.pad_width / 2) & (a <= 0) & (a >= -HAND.pad_depth)
+        pad &= np.abs(c) < HAND.width_max / 2
         on_seen, on_guess = a[pad & ~guessed], a[pad & guessed]
         return max(on_seen.min(), on_guess.min()) <= min(on_seen.max(), on_guess.max())
 
@@ -432,7 +436,7 @@ def test_the_hand_keeps_its_side_clearance_from_every_point():
         for cloud in (pts, other):
             assert not in_fingers(g, cloud, grow=near).any()
             assert not in_palm(g, cloud, grow=near).any()
-    assert max(g.width for g in grasps) <= S.width_max - 2 * S.side_clearance
+    assert max(g.width for g in grasps) <= HAND.width_max - 2 * S.side_clearance
 
 
 def test_without_side_clearance_the_fingers_may_graze_the_object():
@@ -479,7 +483,7 @@ def local_setup(target: np.ndarray, normals: np.ndarray, n_samples: int, seed: i
     """Samples, their frames, orientations and closing grid, as detect_grasps builds them."""
     idx = sample_indices(len(target), n_samples, np.random.default_rng(seed))
     normal, axis = local_frames(target, normals, idx, S)
-    return target[idx], normal, axis, orientation_angles(S.gpd_orientations), ClosingGrid(S)
+    return target[idx], normal, axis, orientation_angles(S.gpd_orientations), ClosingGrid(HAND, S)
 
 
 def test_pruned_tips_equal_the_direct_computation():
@@ -487,12 +491,12 @@ def test_pruned_tips_equal_the_direct_computation():
     other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
     cloud = np.vstack([table(), other, pts])
     samples, normal, axis, angles, grid = local_setup(pts, noisy(n), 120)
-    regions = hand_regions(S)
+    regions = hand_regions(HAND, S)
     sid, _, h, u, v = slab_pairs(cloud, samples, normal, axis, regions)
-    direct = deepest_tips(h, u, v, sid, len(samples), angles, grid, S)
+    direct = deepest_tips(h, u, v, sid, len(samples), angles, grid, HAND, S)
     want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
     pairs = CoarsePairs(cloud, samples, normal, axis, regions)
-    pruned = pruned_tips(pairs, samples, normal, axis, angles, grid, S, regions, want)
+    pruned = pruned_tips(pairs, samples, normal, axis, angles, grid, HAND, S, regions, want)
     free = np.isfinite(direct) & want[:, :, None]
     assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur
     np.testing.assert_array_equal(np.isfinite(pruned), free)
@@ -503,15 +507,15 @@ def test_antipodal_possible_never_rules_out_a_passing_frame():
     pts, n = cylinder()
     normals = noisy(n)
     samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, _, h, u, v, nu, nv = pad_pairs(pts, normals, samples, normal, axis, S)
-    possible = antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
+    sid, _, h, u, v, nu, nv = pad_pairs(pts, normals, samples, normal, axis, HAND)
+    possible = antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, HAND, S).ravel()
     rng = np.random.default_rng(3)
     passed = np.zeros(len(possible), bool)
     for _ in range(30):  # any placement, any depth the collision test could give
         offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
-        tip = rng.uniform(S.gpd_init_bite, S.finger_length - S.gpd_clearance, len(possible))
+        tip = rng.uniform(S.gpd_init_bite, HAND.finger_length - S.gpd_clearance, len(possible))
         _, ok, _ = closing_region(
-            h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
+            h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), HAND, S
         )
         passed |= ok
     assert passed.sum() > 50 and not possible.all()
@@ -555,25 +559,27 @@ def test_detector_equals_the_direct_computation():
     scene = np.vstack([table(), pts, other]).astype(np.float32)
     fast = detect_grasps(target, normals, scene, given, np.random.default_rng(5))
 
-    s = cleared_hand(given)  # the hand the detector tests
+    hand = cleared_hand(HAND, given.side_clearance)  # the hand the detector tests
 
     centre = 0.5 * (target.min(axis=0) + target.max(axis=0))
     tgt = target - centre
-    idx = sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(5))
-    normal, axis = local_frames(tgt, normals, idx, s)
-    angles, grid = orientation_angles(s.gpd_orientations), ClosingGrid(s)
+    idx = sample_indices(len(tgt), given.gpd_samples, np.random.default_rng(5))
+    normal, axis = local_frames(tgt, normals, idx, given)
+    angles, grid = orientation_angles(given.gpd_orientations), ClosingGrid(hand, given)
     cloud = np.vstack([scene - centre, tgt])
-    sid, _, h, u, v = slab_pairs(cloud, tgt[idx], normal, axis, hand_regions(s))
-    tips = deepest_tips(h, u, v, sid, len(idx), angles, grid, s).reshape(-1, len(grid.offsets))
+    sid, _, h, u, v = slab_pairs(cloud, tgt[idx], normal, axis, hand_regions(hand, given))
+    tips = deepest_tips(h, u, v, sid, len(idx), angles, grid, hand, given).reshape(
+        -1, len(grid.offsets)
+    )
     has, k = middle_placement(np.isfinite(tips))
     offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
     tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, _, th, tu, tv, nu, nv = pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
+    tsid, _, th, tu, tv, nu, nv = pad_pairs(tgt, normals, tgt[idx], normal, axis, hand)
     width, ok, centred = closing_region(
-        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s
+        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, hand, given
     )
     good = np.flatnonzero(ok & has)
-    poses = grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
+    poses = grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], hand)
     poses[:, :3, 3] += centre
 
     assert len(fast) == len(good) > 50

@@ -117,7 +117,7 @@ def test_a_vertical_grasp_on_a_cup_seen_from_the_front_clears_its_far_rim():
     # The cup's far and near sides along the closing axis, from the TCP.
     c = g.closing[:2] / np.linalg.norm(g.closing[:2])
     reach = np.abs((pts[:, :2] - g.position[:2]) @ c).max()
-    assert reach + s.grasp.side_clearance <= s.grasp.width_max / 2
+    assert reach + s.grasp.side_clearance <= dims.GRIPPER_HAND.width_max / 2
 
 
 def test_an_object_seen_from_one_side_is_completed_by_symmetry():

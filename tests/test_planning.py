@@ -560,8 +560,7 @@ def test_the_hand_may_grasp_a_low_object_on_the_floor_but_not_reach_into_it():
     the floor (`vertical_grasp`): the hand at its grasp may come as near the floor as to a
     table's points (every such grasp was once refused: "the hand would hit something beside
     the object"). With the fingertips 5 mm into the floor it is refused."""
-    s = get_settings()
-    half_pad = s.grasp.pad_depth / 2
+    half_pad = dims.GRIPPER_HAND.pad_depth / 2
     plans = {}
     for tips in (0.005, -0.005):
         q = ik_tcp(top_grasp(1.55, -0.30, tips + half_pad), dims.UR5_READY_Q)[0]

@@ -16,6 +16,7 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
+from laserpick.description.dims import GRIPPER_HAND
 from laserpick.settings import GraspSettings
 from laserpick.transforms import pinhole_project
 from laserpick.types import DepthFrame, Grasp
@@ -134,15 +135,16 @@ def beyond_view(
     return copies[~seen_free(copies, [*frames, *others], tolerance)]
 
 
-def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:
+def finger_probes(poses: np.ndarray) -> np.ndarray:
     """(G, P, 3) points (m, `base`) inside the open fingers of the hands at TCP `poses`
     (G, 4, 4): PROBE_ACROSS x PROBE_DOWN in each finger's middle, both fingers."""
     poses = np.asarray(poses, np.float64).reshape(-1, 4, 4)
-    c = s.width_max / 2 + (s.pad_thickness + s.finger_thickness) / 2
-    tip = s.pad_depth / 2  # the TCP lies this far behind the fingertips
+    hand = GRIPPER_HAND
+    c = hand.width_max / 2 + (hand.pad_thickness + hand.finger_thickness) / 2
+    tip = hand.pad_depth / 2  # the TCP lies this far behind the fingertips
     local = np.array(
         [
-            (x * s.finger_width / 2, side * c, tip - d * s.finger_length)
+            (x * hand.finger_width / 2, side * c, tip - d * hand.finger_length)
             for side in (-1.0, 1.0)
             for x in PROBE_ACROSS
             for d in PROBE_DOWN
@@ -158,6 +160,6 @@ def fingers_seen_free(
     grasp's finger probes. True for all when there are no frames to ask."""
     if not frames or not grasps:
         return np.ones(len(grasps), bool)
-    probes = finger_probes(np.array([g.pose for g in grasps]), s)
+    probes = finger_probes(np.array([g.pose for g in grasps]))
     free = seen_free(probes.reshape(-1, 3), frames, s.free_space_tolerance)
     return free.reshape(len(grasps), -1).mean(axis=1) >= s.free_space_share

@@ -26,6 +26,7 @@ from scipy.spatial import cKDTree
 
 from laserpick.description.dims import (
     ARM_MOUNT_POS,
+    GRIPPER_HAND,
     UR5_HIGH_READY_Q,
     UR5_HOME_Q,
     UR5_READY_Q,
@@ -155,7 +156,7 @@ def vertical_grasp(
     # Robust extent: a few stray points (a shadow's edge, the table's rim) do not widen it.
     lo, hi = np.percentile(across, [0.5, 99.5])
     width = float(hi - lo)
-    if width > settings.grasp.width_max - 2 * settings.grasp.side_clearance:
+    if width > GRIPPER_HAND.width_max - 2 * settings.grasp.side_clearance:
         return Failure("detect_grasp", "The object is wider than the gripper opens.")
     middle = centre + 0.5 * (lo + hi) * closing
     approach = np.array([0.0, 0.0, -1.0])
@@ -166,7 +167,7 @@ def vertical_grasp(
     tips = top - VERTICAL_BITE
     if support is not None:
         tips = max(tips, support + VERTICAL_FLOOR_GAP)
-    pose[:3, 3] = [middle[0], middle[1], tips + settings.grasp.pad_depth / 2]
+    pose[:3, 3] = [middle[0], middle[1], tips + GRIPPER_HAND.pad_depth / 2]
     return Grasp(pose=pose, width=width)
 
 
@@ -230,7 +231,7 @@ def candidates(
         target = _above_surface(cloud.points, target, perception.mark.point, settings)
         if len(target) == 0:
             return Failure("detect_grasp", "Nothing stands above the surface at the mark.")
-        g = overhead_grasp(target, cloud.points, floor, ARM_MOUNT_POS[:2], settings.grasp)
+        g = overhead_grasp(target, cloud.points, floor, ARM_MOUNT_POS[:2])
     else:
         g = vertical_grasp(target, support, settings)
     return g if isinstance(g, Failure) else [g]

@@ -8,16 +8,13 @@ __all__ = ["GraspSettings"]
 
 
 class GraspSettings(BaseModel):
-    """Grasp selection parameters (paper 004 section 7) and the hand geometry the pipeline uses.
+    """Grasp detection (GPD) and selection parameters (paper 004 sections 6.2 and 7).
 
-    The hand geometry mirrors the gripper in `laserpick.description.dims` (a test holds them equal);
-    it is repeated here because pipeline/ may not import robot/.
+    The hand's geometry is not a setting: it is the gripper's, `description.dims.GRIPPER_HAND`.
     """
 
-    width_min: float = Field(0.0, ge=0, description="Gripper's smallest opening W_min (m).")
-    width_max: float = Field(0.085, gt=0, description="Gripper's stroke W_max (m). 2F-85.")
-    finger_length: float = Field(
-        0.05, gt=0, description="Finger length l, the reach of Cs (m). Eq. 6 of 004."
+    width_min: float = Field(
+        0.0, ge=0, description="W_min of 004 eq. 3, the smallest opening (m); W_max is the stroke."
     )
     width_margin: float = Field(
         0.015, ge=0, description="W_d, the distance kept from the stroke's ends (m). 004 eq. 3."
@@ -37,39 +34,6 @@ class GraspSettings(BaseModel):
         0.02,
         gt=0,
         description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
-    )
-    # Hand geometry for grasp detection (collision boxes); description/dims.py and robot/model.py.
-    pad_depth: float = Field(
-        0.022, gt=0, description="Pad extent along the approach axis (m). description/dims.py."
-    )
-    pad_width: float = Field(
-        0.022, gt=0, description="Pad extent along the hand axis (m). description/dims.py."
-    )
-    pad_thickness: float = Field(
-        0.008, gt=0, description="Pad thickness along the closing axis (m). description/dims.py."
-    )
-    finger_thickness: float = Field(
-        0.008,
-        gt=0,
-        description="Finger plate thickness along the closing axis, outside the pad (m). "
-        "robot/model.py.",
-    )
-    finger_width: float = Field(
-        0.024,
-        gt=0,
-        description="Finger plate extent along the hand axis (m). robot/model.py.",
-    )
-    palm_width: float = Field(
-        0.09, gt=0, description="Palm housing across the closing axis (m). description/dims.py."
-    )
-    palm_depth: float = Field(
-        0.06, gt=0, description="Palm housing along the hand axis (m). description/dims.py."
-    )
-    palm_length: float = Field(
-        0.09,
-        gt=0,
-        description="Palm housing along the approach axis, behind the finger roots (m). "
-        "robot/model.py (GRIPPER_BASE_LENGTH less the 1 cm coupling).",
     )
     side_clearance: float = Field(
         0.004,

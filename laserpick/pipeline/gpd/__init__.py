@@ -9,11 +9,12 @@ axis (x), the closing axis (y, between the fingers) and the approach axis (z, pa
 object); a point's hand coordinates are (h, c, a) along those axes. The TCP lies midway between
 the pads' centres, pad_depth / 2 behind the fingertips.
 
-Hand model (GraspSettings, mirroring description/dims): two fingers, each a box from the inner pad
-face (at +-width_max / 2 from the hand centre when open) outward by pad + plate thickness,
-finger_length deep along the approach and finger_width along the hand axis; behind the finger
-roots a palm box palm_width x palm_depth x palm_length. The detector tests that hand grown
-by side_clearance on its sides (cleared_hand), so a real hand clears what was seen.
+Hand model: the gripper's boxes, `description.dims.GRIPPER_HAND` (`HandGeometry`): two
+fingers, each a box from the inner pad face (at +-width_max / 2 from the hand centre when
+open) outward by pad + plate thickness, finger_length deep along the approach and
+finger_width along the hand axis; behind the finger roots a palm box palm_width x palm_depth
+x palm_length. The detector tests that hand grown by side_clearance on its sides
+(cleared_hand), so a real hand clears what was seen.
 
 Speed: every (sample, orientation) pair is one "frame". Scene points are binned by their
 closing coordinate per frame (np.minimum.at), so each finger placement's deepest collision-free

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from laserpick.description.dims import HandGeometry
 from laserpick.pipeline.gpd.closing_grid import ClosingGrid
 from laserpick.pipeline.gpd.neighbourhoods import ROUNDING, slab_pairs
 from laserpick.settings import GraspSettings
@@ -22,14 +23,14 @@ def pad_pairs(
     samples: np.ndarray,
     normal: np.ndarray,
     axis: np.ndarray,
-    s: GraspSettings,
+    hand: HandGeometry,
 ) -> tuple[np.ndarray, ...]:
     """Target points where some candidate's pads could be, for each sample: (sample index,
     point index, h, u, v, nu, nv), the points' coordinates (m) and their normals' components
     along the same axes (see slab_pairs). The pads' hand-axis extent, out to the farthest pad
     corner."""
-    reach = math.hypot(s.width_max, s.finger_length)
-    region = [(s.pad_width / 2, reach, np.inf)]
+    reach = math.hypot(hand.width_max, hand.finger_length)
+    region = [(hand.pad_width / 2, reach, np.inf)]
     return slab_pairs(target, samples, normal, axis, region, normals)
 
 
@@ -42,6 +43,7 @@ def antipodal_possible(
     n_samples: int,
     angles: np.ndarray,
     grid: ClosingGrid,
+    hand: HandGeometry,
     s: GraspSettings,
 ) -> np.ndarray:
     """(S, O) bool: whether each frame could pass closing_region's antipodal test with any
@@ -55,8 +57,8 @@ def antipodal_possible(
     closing_region's counts from above, so a frame that fails here fails there for any tips.
     """
     n_o = len(angles)
-    c_max = s.width_max / 2 + float(np.max(np.abs(grid.offsets))) + ROUNDING
-    a_lo, a_hi = s.gpd_init_bite - s.pad_depth - ROUNDING, s.finger_length
+    c_max = hand.width_max / 2 + float(np.max(np.abs(grid.offsets))) + ROUNDING
+    a_lo, a_hi = s.gpd_init_bite - hand.pad_depth - ROUNDING, hand.finger_length
     cos_fric = math.cos(math.radians(s.gpd_friction_deg))
     ct = np.cos(angles).astype(np.float32)
     st = np.sin(angles).astype(np.float32)
@@ -93,6 +95,7 @@ def closing_region(
     angles: np.ndarray,
     offset: np.ndarray,
     tip: np.ndarray,
+    hand: HandGeometry,
     s: GraspSettings,
     guessed: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -126,7 +129,7 @@ def closing_region(
     cmax = np.full(n_frames, -np.inf, np.float32)
     cmin = np.full(n_frames, np.inf, np.float32)
     count = np.zeros(n_frames, np.int64)
-    half = s.width_max / 2
+    half = hand.width_max / 2
     parts = []
     for o, theta in enumerate(angles):
         ct, st = math.cos(theta), math.sin(theta)
@@ -134,7 +137,7 @@ def closing_region(
         # Depth first: it is NaN-safe (no candidate: never inside) and drops most pairs.
         a = ct * u + st * v
         t = tip[f]
-        i = np.flatnonzero((a <= t) & (a >= t - s.pad_depth))
+        i = np.flatnonzero((a <= t) & (a >= t - hand.pad_depth))
         f = f[i]
         cc = st * u[i] - ct * v[i] - offset[f]
         inside = np.abs(cc) < half
@@ -174,7 +177,7 @@ def closing_region(
         & (left >= s.gpd_min_contacts)
         & (right >= s.gpd_min_contacts)
         & (width > 0)
-        & (width <= s.width_max)
+        & (width <= hand.width_max)
     )
     if guessed is not None:
         ok &= guesses_face_seen(contacts, n_frames)

@@ -12,6 +12,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from laserpick.description.dims import HandGeometry
 from laserpick.settings import GraspSettings
 
 BINS_PER_PLACEMENT = 4  #: closing-axis bins per finger-placement step (collision resolution)
@@ -26,12 +27,12 @@ class ClosingGrid:
     wide with edges on every placement's inner finger faces.
     """
 
-    def __init__(self, s: GraspSettings) -> None:
-        w, k = s.width_max, s.gpd_finger_placements
+    def __init__(self, hand: HandGeometry, s: GraspSettings) -> None:
+        w, k = hand.width_max, s.gpd_finger_placements
         self.step = w / k
         self.offsets = -w / 2 + (np.arange(k) + 0.5) * self.step
         self.bin = self.step / BINS_PER_PLACEMENT
-        self.finger_thick = s.pad_thickness + s.finger_thickness
+        self.finger_thick = hand.pad_thickness + hand.finger_thickness
         self.n_finger_bins = math.ceil(self.finger_thick / self.bin - 1e-9)
         # Bin 0 starts n0 bins below the first left inner face (at step / 2).
         self.n0 = math.ceil((w + self.finger_thick) / self.bin - 1e-9) + 1
@@ -41,7 +42,7 @@ class ClosingGrid:
         ks = np.arange(k)
         self.left = self.n0 + ks * BINS_PER_PLACEMENT  # first bin of each left finger
         self.right = self.n0 + (ks - k) * BINS_PER_PLACEMENT  # one past each right finger
-        half_palm = s.palm_width / 2
+        half_palm = hand.palm_width / 2
         self.palm_lo = np.floor((self.offsets - half_palm - self.lo) / self.bin).astype(int)
         self.palm_hi = np.floor((self.offsets + half_palm - self.lo) / self.bin).astype(int) + 1
         self.palm_lo = np.clip(self.palm_lo, 0, self.n_bins)
@@ -92,6 +93,7 @@ def bin_minima(
     n_samples: int,
     angles: np.ndarray,
     grid: ClosingGrid,
+    hand: HandGeometry,
     s: GraspSettings,
     select: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -105,13 +107,13 @@ def bin_minima(
     starting hand's finger roots on; the palm's is wider along the hand axis and starts at the
     starting palm's rear.
     """
-    F, t0, n_o, n_b = s.finger_length, s.gpd_init_bite, len(angles), grid.n_bins
+    F, t0, n_o, n_b = hand.finger_length, s.gpd_init_bite, len(angles), grid.n_bins
     n_frames = n_samples * n_o
     finger_min = np.full(n_b * n_frames, np.inf, np.float32)
     palm_min = np.full(n_b * n_frames, np.inf, np.float32)
     bands = (
-        (finger_min, max(s.finger_width, s.pad_width) / 2, t0 - F, 0.0),
-        (palm_min, s.palm_depth / 2, t0 - F - s.palm_length, F),
+        (finger_min, max(hand.finger_width, hand.pad_width) / 2, t0 - F, 0.0),
+        (palm_min, hand.palm_depth / 2, t0 - F - hand.palm_length, F),
     )
     for o, p in orientation_blocks(select, len(h), n_o):
         ah = np.abs(h.take(p))
@@ -155,6 +157,7 @@ def deepest_tips(
     n_samples: int,
     angles: np.ndarray,
     grid: ClosingGrid,
+    hand: HandGeometry,
     s: GraspSettings,
 ) -> np.ndarray:
     """(S, O, K) deepest fingertip position t (m along the approach, from the sample) that a
@@ -168,7 +171,7 @@ def deepest_tips(
     This is the direct computation over every (sample, point) pair of slab_pairs(cloud, ...,
     hand_regions); the detector gets the same result faster from pruned_tips.
     """
-    stop = placement_minima(*bin_minima(h, u, v, sid, n_samples, angles, grid, s), grid)
+    stop = placement_minima(*bin_minima(h, u, v, sid, n_samples, angles, grid, hand, s), grid)
     return tips_from_stops(stop, s).reshape(n_samples, len(angles), len(grid.offsets))
 
 

@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial import cKDTree
 
+from laserpick.description.dims import GRIPPER_HAND, HandGeometry
 from laserpick.pipeline.gpd.antipodal import antipodal_possible, closing_region, pad_pairs
 from laserpick.pipeline.gpd.candidates import HandCandidates
 from laserpick.pipeline.gpd.closing_grid import ClosingGrid, middle_placement
@@ -62,7 +63,8 @@ def detect_grasps(
             timings[stage] = timings.get(stage, 0.0) + now - clock[0]
         clock[0] = now
 
-    s = cleared_hand(settings or get_settings().grasp)
+    s = settings or get_settings().grasp
+    hand = cleared_hand(GRIPPER_HAND, s.side_clearance)
     rng = rng if rng is not None else np.random.default_rng(0)
     target = np.asarray(target, np.float64).reshape(-1, 3)
     if len(target) < 3:
@@ -80,7 +82,7 @@ def detect_grasps(
         normal, axis = tilted_frames(normal, axis, np.asarray(tilts, np.float64))
         samples = np.tile(samples, (len(tilts), 1))
     lap("frames")
-    search = CandidateSearch(tgt, normals, scene, centre, tree, s, guessed, lap)
+    search = CandidateSearch(tgt, normals, scene, centre, tree, hand, s, guessed, lap)
     first = search.candidates(samples, normal, axis)
     passes = (first, search.recentred(first))
     poses = np.vstack([f.poses for f in passes])
@@ -101,7 +103,7 @@ def detect_grasps(
 class CandidateSearch:
     """The detector's passes over frames of one target: its points relative to their centre
     (`tgt`, with their normals and KD-tree), the collision cloud around them (built once, when
-    a frame first needs it) and the cleared hand `s`."""
+    a frame first needs it), the cleared hand `hand` and the settings `s`."""
 
     def __init__(
         self,
@@ -110,16 +112,17 @@ class CandidateSearch:
         scene: np.ndarray,
         centre: np.ndarray,
         tree: cKDTree,
+        hand: HandGeometry,
         s: GraspSettings,
         guessed: np.ndarray | None,
         lap: Callable[[str], None],
     ) -> None:
         self.tgt, self.normals, self.tree = tgt, normals, tree
         self.scene, self.centre = scene, centre
-        self.s, self.guessed, self.lap = s, guessed, lap
+        self.hand, self.s, self.guessed, self.lap = hand, s, guessed, lap
         self.angles = orientation_angles(s.gpd_orientations)
-        self.grid = ClosingGrid(s)
-        self.regions = hand_regions(s)
+        self.grid = ClosingGrid(hand, s)
+        self.regions = hand_regions(hand, s)
         self._cloud: np.ndarray | None = None
 
     def cloud(self) -> np.ndarray:
@@ -141,12 +144,14 @@ class CandidateSearch:
         """The passing candidates of every orientation of the frames at `samples` ((S, 3),
         relative to the target's centre) with those normals and curvature axes; with `only`
         ((S,) orientation indices), of that one orientation of each."""
-        s, angles, grid, lap = self.s, self.angles, self.grid, self.lap
+        hand, s, angles, grid, lap = self.hand, self.s, self.angles, self.grid, self.lap
         # The pads' contents: target points where the pads could be. Most frames cannot pass
         # the antipodal test whatever the hand's depth and offset: they need no collision
         # test.
-        tsid, tpid, th, tu, tv, nu, nv = pad_pairs(self.tgt, self.normals, samples, normal, axis, s)
-        possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, s)
+        tsid, tpid, th, tu, tv, nu, nv = pad_pairs(
+            self.tgt, self.normals, samples, normal, axis, hand
+        )
+        possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, hand, s)
         if only is not None:
             possible &= np.arange(len(angles)) == np.asarray(only)[:, None]
         live = np.flatnonzero(possible.any(axis=1))
@@ -164,6 +169,7 @@ class CandidateSearch:
                 axis[live],
                 angles,
                 grid,
+                hand,
                 s,
                 self.regions,
                 possible[live],
@@ -178,12 +184,12 @@ class CandidateSearch:
         th, tu, tv, nu, nv, tsid, tpid = (x.take(keep) for x in (th, tu, tv, nu, nv, tsid, tpid))
         pair_guessed = None if self.guessed is None else np.asarray(self.guessed, bool).take(tpid)
         width, ok, centred = closing_region(
-            th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s, pair_guessed
+            th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, hand, s, pair_guessed
         )
         lap("closing_region")
         good = np.flatnonzero(ok & has)
         sample, orientation = np.divmod(good, len(angles))
-        poses = grasp_poses(samples, normal, axis, angles, good, offset[good], tip[good], s)
+        poses = grasp_poses(samples, normal, axis, angles, good, offset[good], tip[good], hand)
         return HandCandidates(
             samples,
             normal,
@@ -203,7 +209,7 @@ class CandidateSearch:
         (`patch_moves`) and tested again from scratch: those that pass and are centred now.
         Ours, beyond GPD (see patch_moves)."""
         off = np.flatnonzero(~found.centred)
-        turn, shift = patch_moves(self.tgt, self.normals, self.s, found.subset(off))
+        turn, shift = patch_moves(self.tgt, self.normals, self.hand, self.s, found.subset(off))
         moved = np.flatnonzero(np.isfinite(shift))
         self.lap("recentre")
         if not len(moved):

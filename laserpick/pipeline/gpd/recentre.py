@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from laserpick.description.dims import HandGeometry
 from laserpick.pipeline.gpd.candidates import HandCandidates
 from laserpick.pipeline.gpd.neighbourhoods import slab_pairs
 from laserpick.settings import GraspSettings
@@ -18,7 +19,11 @@ MIN_TURN = math.radians(1.0)  #: rad; nor turns one by less
 
 
 def patch_moves(
-    tgt: np.ndarray, normals: np.ndarray, s: GraspSettings, found: HandCandidates
+    tgt: np.ndarray,
+    normals: np.ndarray,
+    hand: HandGeometry,
+    s: GraspSettings,
+    found: HandCandidates,
 ) -> tuple[np.ndarray, np.ndarray]:
     """How to move each of `found`'s hands so that its pads meet the object along their
     faces, about their middle (closing_region's tangent patches): a turn (rad) about the hand
@@ -49,7 +54,13 @@ def patch_moves(
     if s.gpd_recentre <= 0 or not len(found):
         return turn, shift
     i = found.sample
-    region = [(s.pad_width / 2 + s.gpd_recentre, math.hypot(s.width_max, s.finger_length), np.inf)]
+    region = [
+        (
+            hand.pad_width / 2 + s.gpd_recentre,
+            math.hypot(hand.width_max, hand.finger_length),
+            np.inf,
+        )
+    ]
     f, _, h, u, v, nu, nv = slab_pairs(
         tgt, found.samples[i], found.normal[i], found.axis[i], region, normals
     )
@@ -63,7 +74,7 @@ def patch_moves(
         a = ct * u + st * v
         cc = st * u - ct * v - found.offset.take(f)
         tip = found.tip.take(f)
-        inside = (a <= tip) & (a >= tip - s.pad_depth) & (np.abs(cc) < s.width_max / 2)
+        inside = (a <= tip) & (a >= tip - hand.pad_depth) & (np.abs(cc) < hand.width_max / 2)
         cmax = np.full(len(found), -np.inf, np.float32)
         cmin = np.full(len(found), np.inf, np.float32)
         np.maximum.at(cmax, f[inside], cc[inside])

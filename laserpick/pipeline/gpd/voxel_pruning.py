@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from laserpick.description.dims import HandGeometry
 from laserpick.pipeline.gpd.closing_grid import (
     ClosingGrid,
     bin_minima,
@@ -112,6 +113,7 @@ def pruned_tips(
     axis: np.ndarray,
     angles: np.ndarray,
     grid: ClosingGrid,
+    hand: HandGeometry,
     s: GraspSettings,
     regions: list[tuple[float, float, float]],
     want: np.ndarray | None = None,
@@ -134,7 +136,7 @@ def pruned_tips(
     placement's stop, and whether it is free, come out as deepest_tips has them.
     """
     vox = pairs.voxels
-    F, t0 = s.finger_length, s.gpd_init_bite
+    F, t0 = hand.finger_length, s.gpd_init_bite
     n_s, n_o, n_b = len(samples), len(angles), grid.n_bins
     basis, own = frame_bases(samples, normal, axis)
     basis = np.ascontiguousarray(basis.transpose(1, 2, 0), np.float32)  # for point_coords
@@ -154,6 +156,7 @@ def pruned_tips(
         n_s,
         angles,
         grid,
+        hand,
         s,
         by_orientation(want, sid),
     )
@@ -183,7 +186,7 @@ def pruned_tips(
 
     # Only (pair, orientation) combinations whose frame has a free placement, and whose voxel
     # may reach into a band, can need a closer look.
-    finger_h, palm_h = max(s.finger_width, s.pad_width) / 2, s.palm_depth / 2
+    finger_h, palm_h = max(hand.finger_width, hand.pad_width) / 2, hand.palm_depth / 2
     least_h = np.abs(pairs.h) - pairs.radius
     select = by_orientation(live.reshape(n_s, n_o), pairs.sid, least_h <= max(finger_h, palm_h))
     hits: list[list[np.ndarray]] = [[np.zeros(0, np.intp)] for _ in range(n_o)]
@@ -198,7 +201,9 @@ def pruned_tips(
         col = column.take(pairs.sid.take(p) * n_o + o)
         least, most = a - r, a + r
         need = ((lh <= finger_h) & (most >= t0 - F) & (least < worst_f(j_lo, j_hi, col))) | (
-            (lh <= palm_h) & (most >= t0 - F - s.palm_length) & (least < worst_p(j_lo, j_hi, col))
+            (lh <= palm_h)
+            & (most >= t0 - F - hand.palm_length)
+            & (least < worst_p(j_lo, j_hi, col))
         )
         hits[o].append(p[need])
 
@@ -219,7 +224,7 @@ def pruned_tips(
     row = parent.take(keep)
     select = np.stack([in_row.take(row) for in_row in need])
     more = bin_minima(
-        h.take(keep), u.take(keep), v.take(keep), sid.take(keep), n_s, angles, grid, s, select
+        h.take(keep), u.take(keep), v.take(keep), sid.take(keep), n_s, angles, grid, hand, s, select
     )
     stop = placement_minima(np.minimum(lower[0], more[0]), np.minimum(lower[1], more[1]), grid)
     stop[~want.ravel()] = -np.inf
