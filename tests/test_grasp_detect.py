@@ -28,9 +28,9 @@ from laserpick.pipeline.gpd.frames import (
     tilted_frames,
 )
 from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
-from laserpick.pipeline.gpd.neighbourhoods import slab_pairs
+from laserpick.pipeline.gpd.neighbourhoods import VoxelGroups, slab_pairs
 from laserpick.pipeline.gpd.recentre import patch_moves
-from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, RangeMax, VoxelGroups, pruned_tips
+from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, RangeMax, pruned_tips
 from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 

@@ -119,12 +119,51 @@ def closing_region(
     (`Grasp.pads_centred`). A pad's tangent patch is its contacts whose normals lie within
     gpd_tangent_deg of the closing axis: where the object's face lies along the pad. Each
     pad must have one, and the middle of its extent along the hand axis must lie within
-    gpd_patch_offset of the pad's. The friction cone alone passes a hand tilted 13 degrees
-    over a can's top and shifted along it until the can's side lies along the pads only
-    past their edges. The simulation's pads then meet it with a corner, whose contact
-    normal turns to the pad's side and spins the can out (seed 1's soda can, stop 57). A
-    verdict, not a rule: such a grasp is often the only one an object offers.
+    gpd_patch_offset of the pad's. The friction cone alone passes pads that meet a can's
+    side only past their edges, where a pad's corner turns the contact normal and spins the
+    can out. A verdict, not a rule: such a grasp is often the only one an object offers.
     """
+    n_frames = len(offset)
+    parts, cmax, cmin, count = _pad_contents(h, u, v, nu, nv, frame, angles, offset, tip, hand)
+    left, right, patch_lo, patch_hi, contacts = _pad_contacts(
+        parts, cmax, cmin, n_frames, s, guessed
+    )
+    width = cmax - cmin
+    ok = (
+        (count >= s.gpd_min_points)
+        & (left >= s.gpd_min_contacts)
+        & (right >= s.gpd_min_contacts)
+        & (width > 0)
+        & (width <= hand.width_max)
+    )
+    if guessed is not None:
+        ok &= guesses_face_seen(contacts, n_frames)
+    centred = (patch_lo <= patch_hi).all(axis=0) & (
+        np.abs(patch_lo + patch_hi) / 2 <= s.gpd_patch_offset
+    ).all(axis=0)
+    return width, ok, centred
+
+
+PadPoints = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""The target points between one orientation's pads: each one's pair index, frame, closing
+coordinate from the hand centre (m), normal . closing axis, depth along the approach (m) and
+hand-axis coordinate (m)."""
+
+
+def _pad_contents(
+    h: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    nu: np.ndarray,
+    nv: np.ndarray,
+    frame: np.ndarray,
+    angles: np.ndarray,
+    offset: np.ndarray,
+    tip: np.ndarray,
+    hand: HandGeometry,
+) -> tuple[list[PadPoints], np.ndarray, np.ndarray, np.ndarray]:
+    """closing_region's points between the pads, per orientation (`PadPoints`), and per
+    frame their largest and least closing coordinates (m) and their count."""
     n_frames = len(offset)
     cmax = np.full(n_frames, -np.inf, np.float32)
     cmin = np.full(n_frames, np.inf, np.float32)
@@ -147,6 +186,20 @@ def closing_region(
         np.minimum.at(cmin, f, cc)
         count += np.bincount(f, minlength=n_frames)
         parts.append((i, f, cc, ndot, a[i], h[i]))
+    return parts, cmax, cmin, count
+
+
+def _pad_contacts(
+    parts: list[PadPoints],
+    cmax: np.ndarray,
+    cmin: np.ndarray,
+    n_frames: int,
+    s: GraspSettings,
+    guessed: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[Contacts]]:
+    """closing_region's contacts: per frame, the antipodal contacts on the left and right
+    pads (counts), each pad's tangent patch along the hand axis ([pad, frame] least and
+    largest, m; empty where lo > hi) and, with `guessed`, the antipodal contacts."""
     cos_fric = math.cos(math.radians(s.gpd_friction_deg))
     left = np.zeros(n_frames, np.int64)
     right = np.zeros(n_frames, np.int64)
@@ -171,20 +224,7 @@ def closing_region(
             at = np.flatnonzero(on_left | on_right)
             side = (~on_left).take(at).astype(np.int64)  # 0 left, 1 right
             contacts.append((f.take(at), side, depth.take(at), guessed.take(i.take(at))))
-    width = cmax - cmin
-    ok = (
-        (count >= s.gpd_min_points)
-        & (left >= s.gpd_min_contacts)
-        & (right >= s.gpd_min_contacts)
-        & (width > 0)
-        & (width <= hand.width_max)
-    )
-    if guessed is not None:
-        ok &= guesses_face_seen(contacts, n_frames)
-    centred = (patch_lo <= patch_hi).all(axis=0) & (
-        np.abs(patch_lo + patch_hi) / 2 <= s.gpd_patch_offset
-    ).all(axis=0)
-    return width, ok, centred
+    return left, right, patch_lo, patch_hi, contacts
 
 
 def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
@@ -192,12 +232,10 @@ def guesses_face_seen(contacts: list[Contacts], n_frames: int) -> np.ndarray:
     their depths along the approach do not overlap those of the other pad's seen contacts.
 
     The back `mirrored_back` guesses is right for a symmetric object seen square on. Seen at
-    a slant, or past an end, it lies beside the seen face rather than opposite it: a box
-    held by its end edge had one pad on its seen face, 4-11 mm behind the tips, and the other
-    only on guessed points, 4-10 mm in front of them (pick-place, seed 102, task 9). The
-    pads closed on 1.25 cm of a 6.75 cm grasp, and the box turned out of them. A pad on seen
-    points, and a guessed one at the same depth, are at least a real surface faced by its
-    likely back.
+    a slant, or past an end, it lies beside the seen face rather than opposite it, and pads
+    on the one and the other close on a sliver of the object, which turns out of them. A pad
+    on seen points, and a guessed one at the same depth, are at least a real surface faced
+    by its likely back.
     """
     lo = np.full((2, 2, n_frames), np.inf, np.float32)  # [pad, guessed, frame]
     hi = np.full((2, 2, n_frames), -np.inf, np.float32)

@@ -54,15 +54,7 @@ def detect_grasps(
     guessed: (M,) bool, the target points that were guessed (`mirrored_back`) rather than
     seen; see `guesses_face_seen`.
     """
-    t_start = time.perf_counter()
-    clock = [t_start]
-
-    def lap(stage: str) -> None:
-        now = time.perf_counter()
-        if timings is not None:
-            timings[stage] = timings.get(stage, 0.0) + now - clock[0]
-        clock[0] = now
-
+    lap = StageTimer(timings)
     s = settings or get_settings().grasp
     hand = cleared_hand(GRIPPER_HAND, s.side_clearance)
     rng = rng if rng is not None else np.random.default_rng(0)
@@ -84,11 +76,32 @@ def detect_grasps(
     lap("frames")
     search = CandidateSearch(tgt, normals, scene, centre, tree, hand, s, guessed, lap)
     first = search.candidates(samples, normal, axis)
-    passes = (first, search.recentred(first))
+    grasps = as_grasps((first, search.recentred(first)), centre)
+    if timings is not None:
+        timings["total"] = time.perf_counter() - lap.start
+    return grasps
+
+
+class StageTimer:
+    """Adds the seconds since its last call (or its making) to `timings[stage]` when called
+    with a stage's name; nothing when `timings` is None."""
+
+    def __init__(self, timings: dict[str, float] | None) -> None:
+        self.timings = timings
+        self.start = self.last = time.perf_counter()
+
+    def __call__(self, stage: str) -> None:
+        now = time.perf_counter()
+        if self.timings is not None:
+            self.timings[stage] = self.timings.get(stage, 0.0) + now - self.last
+        self.last = now
+
+
+def as_grasps(passes: tuple[HandCandidates, ...], centre: np.ndarray) -> list[Grasp]:
+    """The candidates of the detector's `passes`, in order, as grasps in `base`: their poses
+    are relative to the target's `centre` (m, `base`)."""
     poses = np.vstack([f.poses for f in passes])
     poses[:, :3, 3] += centre
-    if timings is not None:
-        timings["total"] = time.perf_counter() - t_start
     return [
         Grasp(pose=T, width=float(w), pads_centred=bool(c))
         for T, w, c in zip(
@@ -154,27 +167,9 @@ class CandidateSearch:
         possible = antipodal_possible(tu, tv, nu, nv, tsid, len(samples), angles, grid, hand, s)
         if only is not None:
             possible &= np.arange(len(angles)) == np.asarray(only)[:, None]
-        live = np.flatnonzero(possible.any(axis=1))
         lap("pad_pairs")
 
-        # Collisions and depth, for those frames: scene points where the hand could be.
-        tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
-        if len(live):
-            pairs = CoarsePairs(self.cloud(), samples[live], normal[live], axis[live], self.regions)
-            lap("collision_pairs")
-            tips[live] = pruned_tips(
-                pairs,
-                samples[live],
-                normal[live],
-                axis[live],
-                angles,
-                grid,
-                hand,
-                s,
-                self.regions,
-                possible[live],
-            )
-        tips = tips.reshape(len(samples) * len(angles), -1)
+        tips = self.deepest_tips(samples, normal, axis, possible)
         has, k = middle_placement(np.isfinite(tips))
         offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
         tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
@@ -203,6 +198,33 @@ class CandidateSearch:
             centred[good],
             poses,
         )
+
+    def deepest_tips(
+        self, samples: np.ndarray, normal: np.ndarray, axis: np.ndarray, possible: np.ndarray
+    ) -> np.ndarray:
+        """(S * O, K) the deepest collision-free fingertip depth (m; -inf for none) of each
+        frame and placement, for the frames `possible` ((S, O) bool) marks; -inf for the
+        others. Only the scene points where the hand could be are looked at
+        (`pruned_tips`)."""
+        angles, grid = self.angles, self.grid
+        live = np.flatnonzero(possible.any(axis=1))
+        tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
+        if len(live):
+            pairs = CoarsePairs(self.cloud(), samples[live], normal[live], axis[live], self.regions)
+            self.lap("collision_pairs")
+            tips[live] = pruned_tips(
+                pairs,
+                samples[live],
+                normal[live],
+                axis[live],
+                angles,
+                grid,
+                self.hand,
+                self.s,
+                self.regions,
+                possible[live],
+            )
+        return tips.reshape(len(samples) * len(angles), -1)
 
     def recentred(self, found: HandCandidates) -> HandCandidates:
         """The hands of `found` that are not centred, moved onto their patches

@@ -1,6 +1,7 @@
 """Scene and target points near GPD's samples, in each sample's frame: cropping and thinning
 the cloud, the regions a hand can reach around a sample, and the blocked matrix products that
-give every (sample, point) pair's coordinates (h, u, v). Frames: `base` axes, metres.
+give every (sample, point) pair's coordinates (h, u, v), and the cloud grouped by voxel
+(`VoxelGroups`). Frames: `base` axes, metres.
 """
 
 from __future__ import annotations
@@ -168,3 +169,47 @@ def point_coords(
         - own[i].take(sid)
         for i in range(3)
     )
+
+
+class VoxelGroups:
+    """Cloud points grouped by the voxel (edge `edge`, m) they fall in.
+
+    points: (N, 3) float32, sorted so that each voxel's points are contiguous (xyz: the same
+    as (3, N)); starts, counts: (V,) each voxel's run in `points`; rep: (V,) index into
+    `points` of each voxel's representative, the point nearest the voxel's centroid; radius:
+    (V,) float32, the largest distance (m) from the representative to a point of its voxel,
+    plus a rounding margin. Every point of voxel i lies within radius[i] of points[rep[i]].
+    """
+
+    def __init__(self, points: np.ndarray, edge: float) -> None:
+        points = np.asarray(points, np.float32)  # as slab_pairs uses them
+        lo = points.min(axis=0)
+        dims = np.floor((points.max(axis=0) - lo) / np.float32(edge)).astype(np.int64) + 1
+        cell = np.floor((points - lo) / np.float32(edge)).astype(np.int64)
+        key = (cell[:, 0] * dims[1] + cell[:, 1]) * dims[2] + cell[:, 2]
+        order = np.argsort(key)
+        key = key.take(order)
+        self.points = points.take(order, axis=0)
+        self.starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        self.counts = np.diff(np.r_[self.starts, len(key)])
+        group = np.repeat(np.arange(len(self.starts)), self.counts)
+        centroid = np.add.reduceat(self.points, self.starts) / self.counts[:, None]
+        d = self.points - centroid.take(group, axis=0)
+        dist = np.einsum("ij,ij->i", d, d)
+        nearest = np.minimum.reduceat(dist, self.starts)
+        index = np.arange(len(self.points))
+        self.rep = np.minimum.reduceat(
+            np.where(dist == nearest.take(group), index, len(index)), self.starts
+        )
+        d = self.points - self.points.take(self.rep.take(group), axis=0)
+        spread = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", d, d), self.starts))
+        self.radius = (spread + ROUNDING).astype(np.float32)
+        self.xyz = np.ascontiguousarray(self.points.T)  # for point_coords
+
+    def members(self, voxels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The points of each of `voxels` (R,): (E,) index into `voxels` and (E,) index into
+        `points`, voxel by voxel."""
+        count = self.counts[voxels]
+        parent = np.repeat(np.arange(len(voxels)), count)
+        first = np.cumsum(count) - count
+        return parent, np.arange(len(parent)) - first[parent] + self.starts[voxels][parent]

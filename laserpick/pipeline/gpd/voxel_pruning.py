@@ -20,7 +20,7 @@ from laserpick.pipeline.gpd.closing_grid import (
     tips_from_stops,
 )
 from laserpick.pipeline.gpd.neighbourhoods import (
-    ROUNDING,
+    VoxelGroups,
     frame_bases,
     in_regions,
     point_coords,
@@ -29,50 +29,6 @@ from laserpick.pipeline.gpd.neighbourhoods import (
 from laserpick.settings import GraspSettings
 
 COLLISION_VOXEL = 0.010  #: voxel edge (m) of pruned_tips' bounds: only speed depends on it
-
-
-class VoxelGroups:
-    """Cloud points grouped by the voxel (edge `edge`, m) they fall in.
-
-    points: (N, 3) float32, sorted so that each voxel's points are contiguous (xyz: the same
-    as (3, N)); starts, counts: (V,) each voxel's run in `points`; rep: (V,) index into
-    `points` of each voxel's representative, the point nearest the voxel's centroid; radius:
-    (V,) float32, the largest distance (m) from the representative to a point of its voxel,
-    plus a rounding margin. Every point of voxel i lies within radius[i] of points[rep[i]].
-    """
-
-    def __init__(self, points: np.ndarray, edge: float) -> None:
-        points = np.asarray(points, np.float32)  # as slab_pairs uses them
-        lo = points.min(axis=0)
-        dims = np.floor((points.max(axis=0) - lo) / np.float32(edge)).astype(np.int64) + 1
-        cell = np.floor((points - lo) / np.float32(edge)).astype(np.int64)
-        key = (cell[:, 0] * dims[1] + cell[:, 1]) * dims[2] + cell[:, 2]
-        order = np.argsort(key)
-        key = key.take(order)
-        self.points = points.take(order, axis=0)
-        self.starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-        self.counts = np.diff(np.r_[self.starts, len(key)])
-        group = np.repeat(np.arange(len(self.starts)), self.counts)
-        centroid = np.add.reduceat(self.points, self.starts) / self.counts[:, None]
-        d = self.points - centroid.take(group, axis=0)
-        dist = np.einsum("ij,ij->i", d, d)
-        nearest = np.minimum.reduceat(dist, self.starts)
-        index = np.arange(len(self.points))
-        self.rep = np.minimum.reduceat(
-            np.where(dist == nearest.take(group), index, len(index)), self.starts
-        )
-        d = self.points - self.points.take(self.rep.take(group), axis=0)
-        spread = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->i", d, d), self.starts))
-        self.radius = (spread + ROUNDING).astype(np.float32)
-        self.xyz = np.ascontiguousarray(self.points.T)  # for point_coords
-
-    def members(self, voxels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The points of each of `voxels` (R,): (E,) index into `voxels` and (E,) index into
-        `points`, voxel by voxel."""
-        count = self.counts[voxels]
-        parent = np.repeat(np.arange(len(voxels)), count)
-        first = np.cumsum(count) - count
-        return parent, np.arange(len(parent)) - first[parent] + self.starts[voxels][parent]
 
 
 class CoarsePairs:
@@ -135,20 +91,41 @@ def pruned_tips(
     A point left out is thus never below the stop of a placement it could reach, so every
     placement's stop, and whether it is free, come out as deepest_tips has them.
     """
-    vox = pairs.voxels
-    F, t0 = hand.finger_length, s.gpd_init_bite
-    n_s, n_o, n_b = len(samples), len(angles), grid.n_bins
+    n_s, n_o = len(samples), len(angles)
     basis, own = frame_bases(samples, normal, axis)
     basis = np.ascontiguousarray(basis.transpose(1, 2, 0), np.float32)  # for point_coords
     own = np.ascontiguousarray(own.T, np.float32)
     want = np.ones((n_s, n_o), bool) if want is None else want
+    sample_xyz = point_coords(samples.T.astype(np.float32), np.arange(n_s), basis, own)
+    lower = _representative_minima(pairs, sample_xyz, want, angles, grid, hand, s, regions)
+    bound = placement_minima(*lower, grid)
+    bound[~want.ravel()] = -np.inf  # blocked, as far as the rest is concerned
+    live, column, worst_f, worst_p = _free_stop_maxima(bound, pairs.voxels, grid, hand, s)
+    need_o = _voxels_to_open(pairs, live, column, worst_f, worst_p, angles, grid, hand, s)
+    more = _opened_minima(pairs, need_o, basis, own, n_s, angles, grid, hand, s, regions)
+    stop = placement_minima(np.minimum(lower[0], more[0]), np.minimum(lower[1], more[1]), grid)
+    stop[~want.ravel()] = -np.inf
+    return tips_from_stops(stop, s).reshape(n_s, n_o, len(grid.offsets))
 
-    # 1. Representatives in the regions, and the samples (cloud points too, and they stop the
-    # palm at finger_length: often the deciding stop).
+
+def _representative_minima(
+    pairs: CoarsePairs,
+    sample_xyz: tuple[np.ndarray, np.ndarray, np.ndarray],
+    want: np.ndarray,
+    angles: np.ndarray,
+    grid: ClosingGrid,
+    hand: HandGeometry,
+    s: GraspSettings,
+    regions: list[tuple[float, float, float]],
+) -> tuple[np.ndarray, np.ndarray]:
+    """pruned_tips' step 1: bin_minima of the representatives in `regions` and of the
+    samples themselves (`sample_xyz`: their (h, u, v); cloud points too, and they stop the
+    palm at finger_length: often the deciding stop), for the frames in `want`."""
+    n_s = len(want)
+    sh, su, sv = sample_xyz
     exact = np.flatnonzero(in_regions(pairs.h, pairs.u, pairs.v, regions))
-    sh, su, sv = point_coords(samples.T.astype(np.float32), np.arange(n_s), basis, own)
     sid = np.r_[pairs.sid.take(exact), np.arange(n_s)]
-    lower = bin_minima(
+    return bin_minima(
         np.r_[pairs.h.take(exact), sh],
         np.r_[pairs.u.take(exact), su],
         np.r_[pairs.v.take(exact), sv],
@@ -160,18 +137,22 @@ def pruned_tips(
         s,
         by_orientation(want, sid),
     )
-    bound = placement_minima(*lower, grid)
-    bound[~want.ravel()] = -np.inf  # blocked, as far as the rest is concerned
 
-    # 2. Per bin and frame, the largest stop bound of the free placements covering that bin
-    # (for the palm less finger_length, to compare with depths), and its maxima over runs of
-    # bins. Only frames with a free placement are left to settle.
+
+def _free_stop_maxima(
+    bound: np.ndarray, vox: VoxelGroups, grid: ClosingGrid, hand: HandGeometry, s: GraspSettings
+) -> tuple[np.ndarray, np.ndarray, RangeMax, RangeMax]:
+    """pruned_tips' step 2 tables: per bin and frame, the largest stop bound (`bound`, (F, K)
+    m) of the free placements covering that bin (for the palm less finger_length, to compare
+    with depths), as RangeMax over runs of bins as wide as a voxel of `vox` can span. Only
+    frames with a free placement are left to settle: `live` (F,) says which, `column` maps a
+    frame to its column of the tables."""
     free = tips_from_stops(bound, s) > -np.inf  # (F, K)
     live = free.any(axis=1)
     column = np.cumsum(live) - 1  # frame -> column of the tables below
     free = np.where(free, bound, -np.inf)[live].T  # (K, live frames)
-    worst_f = np.full((n_b, len(free[0])), -np.inf, np.float32)
-    worst_p = np.full((n_b, len(free[0])), -np.inf, np.float32)
+    worst_f = np.full((grid.n_bins, len(free[0])), -np.inf, np.float32)
+    worst_p = np.full((grid.n_bins, len(free[0])), -np.inf, np.float32)
     nf = grid.n_finger_bins
     for k in range(len(grid.offsets)):
         for lo, hi in (
@@ -180,15 +161,29 @@ def pruned_tips(
         ):
             np.maximum(worst_f[lo:hi], free[k], out=worst_f[lo:hi])
         lo, hi = grid.palm_lo[k], grid.palm_hi[k]
-        np.maximum(worst_p[lo:hi], free[k] - F, out=worst_p[lo:hi])
+        np.maximum(worst_p[lo:hi], free[k] - hand.finger_length, out=worst_p[lo:hi])
     widest = math.floor(2 * float(vox.radius.max()) / grid.bin) + 2  # bins a voxel can span
-    worst_f, worst_p = RangeMax(worst_f, widest), RangeMax(worst_p, widest)
+    return live, column, RangeMax(worst_f, widest), RangeMax(worst_p, widest)
 
-    # Only (pair, orientation) combinations whose frame has a free placement, and whose voxel
-    # may reach into a band, can need a closer look.
+
+def _voxels_to_open(
+    pairs: CoarsePairs,
+    live: np.ndarray,
+    column: np.ndarray,
+    worst_f: RangeMax,
+    worst_p: RangeMax,
+    angles: np.ndarray,
+    grid: ClosingGrid,
+    hand: HandGeometry,
+    s: GraspSettings,
+) -> list[np.ndarray]:
+    """pruned_tips' step 2: per orientation, the (voxel, sample) pairs whose frame has a free
+    placement and whose voxel may reach into a band below the stop bound of a free placement
+    covering its bins (`_free_stop_maxima`)."""
+    F, t0, n_o, n_b = hand.finger_length, s.gpd_init_bite, len(angles), grid.n_bins
     finger_h, palm_h = max(hand.finger_width, hand.pad_width) / 2, hand.palm_depth / 2
     least_h = np.abs(pairs.h) - pairs.radius
-    select = by_orientation(live.reshape(n_s, n_o), pairs.sid, least_h <= max(finger_h, palm_h))
+    select = by_orientation(live.reshape(-1, n_o), pairs.sid, least_h <= max(finger_h, palm_h))
     hits: list[list[np.ndarray]] = [[np.zeros(0, np.intp)] for _ in range(n_o)]
     for o, p in orientation_blocks(select, len(pairs.sid), n_o):
         r, lh, u, v = (x.take(p) for x in (pairs.radius, least_h, pairs.u, pairs.v))
@@ -206,9 +201,26 @@ def pruned_tips(
             & (least < worst_p(j_lo, j_hi, col))
         )
         hits[o].append(p[need])
+    return [np.concatenate(x) for x in hits]
 
-    # 3. The points of the voxels that may matter, for the orientations where they may.
-    need_o = [np.concatenate(x) for x in hits]
+
+def _opened_minima(
+    pairs: CoarsePairs,
+    need_o: list[np.ndarray],
+    basis: np.ndarray,
+    own: np.ndarray,
+    n_s: int,
+    angles: np.ndarray,
+    grid: ClosingGrid,
+    hand: HandGeometry,
+    s: GraspSettings,
+    regions: list[tuple[float, float, float]],
+) -> tuple[np.ndarray, np.ndarray]:
+    """pruned_tips' step 3: bin_minima of the points of the voxels that may matter
+    (`need_o`, per orientation the pairs of `_voxels_to_open`), for the orientations where
+    they may. basis, own: the samples' frames as point_coords takes them."""
+    vox = pairs.voxels
+    n_o = len(angles)
     is_row = np.zeros(len(pairs.sid), bool)
     for p in need_o:
         is_row[p] = True
@@ -223,12 +235,9 @@ def pruned_tips(
     keep = np.flatnonzero(in_regions(h, u, v, regions))
     row = parent.take(keep)
     select = np.stack([in_row.take(row) for in_row in need])
-    more = bin_minima(
+    return bin_minima(
         h.take(keep), u.take(keep), v.take(keep), sid.take(keep), n_s, angles, grid, hand, s, select
     )
-    stop = placement_minima(np.minimum(lower[0], more[0]), np.minimum(lower[1], more[1]), grid)
-    stop[~want.ravel()] = -np.inf
-    return tips_from_stops(stop, s).reshape(n_s, n_o, len(grid.offsets))
 
 
 class RangeMax:
