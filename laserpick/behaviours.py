@@ -32,7 +32,7 @@ from laserpick.pipeline.collision import (
     obstacle_mask,
     surface_front,
 )
-from laserpick.pipeline.grasping import GraspSet, at_pose, plan_first
+from laserpick.pipeline.grasp_choice import GraspSet, at_pose, plan_first
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, timed
 from laserpick.pipeline.reach import pregrasp_pose

@@ -34,8 +34,8 @@ from laserpick.behaviours import (
 from laserpick.bench.operator import Referee
 from laserpick.bench.protocols import jeeves_scene
 from laserpick.description import dims
-from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.description.shapes import body_frames
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     CARRIED_PADDING,
@@ -46,7 +46,7 @@ from laserpick.pipeline.collision import (
     self_filter,
     sphere_centres,
 )
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line, timed
 from laserpick.pipeline.selection import group, score

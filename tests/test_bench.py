@@ -72,7 +72,7 @@ from laserpick.bench.results import RESULT_PACKAGES, environment, outcomes, summ
 from laserpick.bench.runner import run
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasping import UNSEEN_WAYS
+from laserpick.pipeline.grasp_choice import UNSEEN_WAYS
 from laserpick.robot.sim.objects import LIBRARY
 from laserpick.robot.sim.scenes import load_scene, scene_config
 from laserpick.robot.sim.truth import capture

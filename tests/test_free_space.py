@@ -16,7 +16,7 @@ from laserpick.pipeline.free_space import (
     hidden,
     seen_free,
 )
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
 from laserpick.settings import GraspSettings
 from laserpick.types import (

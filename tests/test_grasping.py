@@ -9,8 +9,9 @@ import pytest
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.gpd import detect_grasps
-from laserpick.pipeline.grasping import GraspSet, find_grasps, vertical_grasp
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.strategies import vertical_grasp
 from laserpick.settings import get_settings
 from laserpick.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
 

@@ -11,8 +11,8 @@ import pytest
 from pydantic import ValidationError
 
 from laserpick.description import dims
-from laserpick.description.collision import FLOOR_CLEARANCE, KEEPOUT_BOXES, body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.description.shapes import FLOOR_CLEARANCE, KEEPOUT_BOXES, body_frames
 from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import (
     SEGMENT_COARSE,

@@ -13,7 +13,7 @@ from laserpick.behaviours import HOLD_TURNS, PAST_THE_OPENING, Held, Outcome
 from laserpick.bench.operator import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.server.session import (

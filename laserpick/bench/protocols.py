@@ -56,7 +56,7 @@ from laserpick.bench.operator import (
 from laserpick.bench.picking import Attempt, ScriptedOperator, open_session
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasping import UNSEEN_WAYS
+from laserpick.pipeline.grasp_choice import UNSEEN_WAYS
 from laserpick.robot.sim.objects import LIBRARY, ObjectModel, footprint_half_extents, rest_pose
 from laserpick.robot.sim.scenes import (
     Scene,

@@ -48,8 +48,8 @@ from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse, ray_hit
 from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
-from laserpick.pipeline.grasping import GraspSet, at_pose, find_grasps
-from laserpick.pipeline.laser import detect_mark
+from laserpick.pipeline.grasp_choice import GraspSet, at_pose, find_grasps
+from laserpick.pipeline.laser_spots import detect_mark
 from laserpick.pipeline.perceive import Perception, perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.recall import Recalled, ViewMemory, moved, moved_points

@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.collision import (
+from laserpick.description.shapes import (
     HOUSING_CAPSULES,
     HOUSINGS,
     LINK_CAPSULES,

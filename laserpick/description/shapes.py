@@ -2,7 +2,7 @@
 keep-out boxes around the scooter and its rider.
 
 The same tables build the MuJoCo model (robot/model.py) and the planner's sphere model and
-keep-out boxes (pipeline/collision.py), so what the planner avoids is what the simulator
+keep-out boxes (pipeline/collision/), so what the planner avoids is what the simulator
 collides: the link capsules, the joint housings around each joint, and the boxes of the
 cameras and the projector on the scooter's posts.
 
