@@ -60,8 +60,8 @@ UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
 #: home keeps the hand (TCP) within 0.34 m of the scooter's side and 0.15 m of its front; the
 #: straight moves on to the ready poses turn the elbow over in front, the hand up to 1.22 m
 #: high and 0.66 m ahead. All three are clear of the scooter. The move to ready straight from
-#: home turned it over out to the side instead, the hand 0.57 m out and 0.68 m ahead, into
-#: furniture the cameras had not seen (rad).
+#: home would turn it over out to the side instead, the hand 0.57 m out and 0.68 m ahead,
+#: where the cameras do not see (rad).
 UR5_UNSTOW_Q = np.array([-1.773, -0.338, -1.967, 0.734, -1.571, -0.203])
 #: Holding an object while the user drives and marks where it goes (pick and place): folded
 #: back along the scooter's right side, gripper down, the TCP at about (0.90, -0.65, 0.95) in
@@ -166,8 +166,8 @@ BASKET_CENTER = np.array([0.99, 0.13, 0.80])
 BASKET_INNER = np.array([0.20, 0.32, 0.16])
 BASKET_WALL = 0.008
 #: m. The basket's floor is thicker than its walls: a thin, light object let go above it
-#: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and a floor as thin as the
-#: walls let it pass its middle in one step and fall through. Its top is at the walls' foot.
+#: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and through a floor as thin
+#: as the walls in one step. Its top is at the walls' foot.
 BASKET_FLOOR_THICKNESS = 0.03
 SCOOTER_MASS = 110.0
 

@@ -2,8 +2,8 @@
 
 A fused cloud holds the surfaces the cameras saw, not the space behind them. An object seen
 from the front shows its front; a grasp detector that tests the hand against those points
-only may put a finger down into the object's unseen back (a cereal box standing on a shelf,
-its back guessed too thin, stopped the hand on its way in). The cameras say more than the
+only may put a finger down into the object's unseen back, where a guessed back is too thin.
+The cameras say more than the
 points: along each pixel's ray, space is free up to the depth it read. A point is seen free
 when some camera's reading at its pixel lies beyond it.
 
@@ -92,9 +92,8 @@ def beyond_view(
 
     target (N, 3), `base`: what the cameras saw of the object in `frames`. A point lies at
     the view's edge when it projects within VIEW_EDGE_PX of the border of some frame's
-    image and well inside none. The object may go on beyond: a lying juice bottle on the
-    108 cm table was seen 7.5 cm of its 20.6, and its unseen end, which no plan knew of, met
-    that table as the arm tucked it in (164 N).
+    image and well inside none. The object may go on beyond, and its unseen end, which no
+    plan knows of, can meet the furniture as the arm tucks it in.
 
     So the edge points are carried on, `step` (m) at a time, away from the seen part's
     middle, until the object spans OBJECT_SPAN_MAX that way. The way is level: what stands

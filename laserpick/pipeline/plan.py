@@ -213,12 +213,11 @@ class Searches:
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
-        camera saw: the cameras' view, not what they saw, kept the arm from it (above the
-        108 cm table, over their heads, their rays end on nothing in range). A short search
+        camera saw: the cameras' view, not what they saw, kept the arm from it (over their
+        heads, above a high table, their rays end on nothing in range). A short search
         (UNSEEN_SAMPLES) with its own generator, so the pick's own searches stay as they
         were; it only explains a failure, and such a way is never taken: an object seen in
-        part reaches into that space (a juice bottle lying across the view's edge, seen 8
-        of its 20 cm)."""
+        part may reach into that space."""
         rng = np.random.default_rng(0)
         quick = s.model_copy(update={"rrt_max_samples": UNSEEN_SAMPLES})
         return any(
@@ -280,9 +279,8 @@ def straight_lift(
     too: joint waypoints, or None if none is clear of the surroundings for the arm.
 
     payload: the object as it will be held (points, m, TCP frame), which must keep clear of
-    the arm's upper links all the way (`held_clear_of_arm`). Lifted from far out over the
-    87 cm counter, the arm straightens and its forearm comes down over the hand: a bowl held
-    by its far rim ended the full lift under it, and no way onward could start there."""
+    the arm's upper links all the way (`held_clear_of_arm`): lifting from far out, the arm
+    straightens and its forearm comes down over the hand, and what it holds."""
     for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
         lift = cartesian_line(q_from, lifted_pose(T_grasp, height), s.cartesian_step)
         if lift is None or not surroundings.clearance_ok(lift, hand=False).all():

@@ -46,10 +46,9 @@ def hand_bottom(pose: np.ndarray) -> np.ndarray:
     bottom, the middle of the hand's base between the finger roots (m, the frame of `pose`).
     It lies finger_length behind the fingertips, which are pad_depth / 2 ahead of the TCP.
 
-    Taken at the TCP, Cs preferred the grasps whose pads just reach an object's top edge:
-    on a standing soda can, the five best of 94 had their TCP within 1 cm of its top, and
-    the can slid out of the first while it was carried. At the bottom, Cs prefers the hand
-    the object fills, as 004 means it to ("decreases the possibility that the object will
+    Taken at the TCP, Cs prefers the grasps whose pads just reach an object's top edge, from
+    which a can slides out while it is carried. At the bottom, Cs prefers the hand the object
+    fills, as 004 means it to ("decreases the possibility that the object will
     slide away")."""
     back = GRIPPER_HAND.finger_length - GRIPPER_HAND.pad_depth / 2
     return pose[:3, 3] - back * pose[:3, 2]
@@ -128,7 +127,7 @@ def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> Gra
 
     Ours: 004 orders by score alone. But C does not see where along the pads the object
     lies, and a can met only toward the pads' edges spins out of the hand when the scooter
-    turns (seed 1's soda can, stop 57). Such a grasp is still offered, after the others:
+    turns. Such a grasp is still offered, after the others:
     it is often the only one an object has."""
     s = settings or get_settings().grasp
     if not grasps:

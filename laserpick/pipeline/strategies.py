@@ -50,8 +50,8 @@ def vertical_grasp(
     The band is the target's points within VERTICAL_BITE of its top, where the fingers go,
     when the cameras see enough of it; the top face, those within VERTICAL_CAP. The cameras
     look down on the object from the front and see its top whole; they see less of its sides
-    and back, and the mean of all its points lies toward them (a mug's, 1.5 cm: its far rim
-    then met the far finger).
+    and back, and the mean of all its points lies toward them (a mug's by 1.5 cm, enough for
+    its far rim to meet the far finger).
     """
     top = float(target[:, 2].max())
     band = target[target[:, 2] > top - VERTICAL_BITE]

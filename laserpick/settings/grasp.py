@@ -43,8 +43,8 @@ class GraspSettings(BaseModel):
         " sides and the palm's sides: GPD's detector tests a hand this much larger on each"
         " side, whose opening is this much narrower on each side; a vertical grasp needs the"
         " object this much narrower than the opening on each side. A depth camera sees a box's"
-        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm;"
-        " with no gap a finger slid down an edge it had missed by 0.4 mm. Ours.",
+        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm."
+        " Ours.",
     )
     free_space_tolerance: float = Field(
         0.006,

@@ -91,9 +91,9 @@ def carried_shape(
     surface it stands on.
 
     The cameras see an object from the front and above only, so its back half, and near a
-    table's edge its lower part, are missing from `target` (N, 3); a carry planned around
-    the seen part alone swung a mug's unseen back into the forearm, and a soda can's unseen
-    lower half into the upper arm. `mirrored_back` fills in the back of a box or a cylinder;
+    table's edge its lower part, are missing from `target` (N, 3), and a carry planned around
+    the seen part alone swings them into the arm. `mirrored_back` fills in the back of a box
+    or a cylinder;
     each `voxel` (m) column of the footprint is filled down to `support` (m, the surface's
     height; None: no filling), since the object stands on it. Other shapes are over-covered,
     which only makes the planner more careful. Thinned to one point per `voxel`.
@@ -124,10 +124,8 @@ def object_middle(target: np.ndarray, carried: np.ndarray) -> np.ndarray:
     they saw only the object's front, and the half turn adds its back. Across it, it is the
     middle of what they saw, since the outline of a convex object seen from the front shows
     its whole width; the half turn's axis is the middle of the top they saw, and a top
-    above the cameras shows only part of itself. A cereal box on the 100 cm shelf was seen
-    along all of its 19 cm length but its top along only the 15 cm nearest one end:
-    carried as 22.6 cm long, it was set down turned 135 degrees and 4 cm off its mark.
-    Upright, the middle of `carried`'s height."""
+    above the cameras shows only part of itself, so its half turn's axis lies off the
+    object's middle. Upright, the middle of `carried`'s height."""
     target = np.asarray(target, float).reshape(-1, 3)
     carried = np.asarray(carried, float).reshape(-1, 3)
     middle = (carried.min(axis=0) + carried.max(axis=0)) / 2

@@ -80,8 +80,7 @@ def surface_front(
     points (N, 3), `base`: the cloud; those within `band` (m) of `height` are the surface's
     top. The cameras look down and ahead, so a counter's front runs out of their view before
     its top does, and its near edge with it (the view's edge cuts the top on a slant): a
-    stow planned around what they saw swung the upper arm into the 87 cm counter's unseen
-    front (203 N), about 20 cm nearer than the seen top's edge there. A table is open below
+    counter's unseen front can stand 20 cm nearer than its seen top's edge. A table is open below
     its edge and a round one's edge curves away; the arm has no business under either, so
     the wall only makes the planner more careful there."""
     points = np.asarray(points, float).reshape(-1, 3)
