@@ -59,10 +59,9 @@ def test_body_frames_match_the_simulated_links():
 
 
 def test_keepout_boxes_hold_every_part_of_the_scooter_the_arm_can_reach():
-    # The arm struck the projector and a camera housing, which stood outside the planner's
-    # boxes. Points over every part from the posts up (and over the tiller and the basket)
-    # lie in some box: a box's corners and a grid between them (a cylinder's box), a
-    # capsule's surface.
+    # What the planner avoids must hold what the simulator collides with. Points over every
+    # part from the posts up (and over the tiller and the basket) lie in some box: a box's
+    # corners and a grid between them (a cylinder's box), a capsule's surface.
     m = build_sim_model(None)
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)

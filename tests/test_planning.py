@@ -301,8 +301,7 @@ def test_plan_pick_refuses_a_grasp_under_the_table():
 def test_the_hand_may_grasp_a_low_object_on_the_floor_but_not_reach_into_it():
     """A 2.5 cm tissue packet on the floor, grasped from above with the fingertips 5 mm over
     the floor (`vertical_grasp`): the hand at its grasp may come as near the floor as to a
-    table's points (every such grasp was once refused: "the hand would hit something beside
-    the object"). With the fingertips 5 mm into the floor it is refused."""
+    table's points. With the fingertips 5 mm into the floor it is refused."""
     half_pad = dims.GRIPPER_HAND.pad_depth / 2
     plans = {}
     for tips in (0.005, -0.005):
