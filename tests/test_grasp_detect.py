@@ -1,7 +1,7 @@
 """GPD-style grasp candidates on synthetic point clouds (no simulator).
 
-Shapes are sampled on a 3 mm grid with exact outward normals plus a little noise, standing on
-a 4 mm grid of table points at z = 0. Frames: `base`-like, z up, metres.
+The shapes (`gpd_shapes`) are sampled on a 3 mm grid with exact outward normals plus a little
+noise, standing on a 4 mm grid of table points at z = 0. Frames: `base`-like, z up, metres.
 """
 
 from __future__ import annotations
@@ -10,92 +10,27 @@ import math
 
 import numpy as np
 import pytest
+from gpd_shapes import box, cylinder, noisy, plate, table
 from scipy.spatial import cKDTree
 
 from laserpick.description.dims import GRIPPER_HAND
 from laserpick.pipeline.gpd import CandidateSearch, detect_grasps
 from laserpick.pipeline.gpd.antipodal import (
-    antipodal_possible,
-    closing_region,
     guesses_face_seen,
-    pad_pairs,
 )
-from laserpick.pipeline.gpd.closing_grid import ClosingGrid, deepest_tips, middle_placement
 from laserpick.pipeline.gpd.frames import (
     local_frames,
-    orientation_angles,
     sample_indices,
     tilted_frames,
 )
-from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
-from laserpick.pipeline.gpd.neighbourhoods import VoxelGroups, slab_pairs
+from laserpick.pipeline.gpd.hand import cleared_hand
 from laserpick.pipeline.gpd.recentre import patch_moves
-from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, RangeMax, pruned_tips
 from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 
 S = GraspSettings()
 HAND = GRIPPER_HAND
-SPACING = 0.003  #: m between object points
 FRICTION = math.radians(S.gpd_friction_deg)
-
-
-def table(half: float = 0.3, spacing: float = 0.004) -> np.ndarray:
-    g = np.arange(-half, half, spacing)
-    x, y = np.meshgrid(g, g)
-    return np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-
-
-def noisy(normals: np.ndarray, seed: int = 7, sigma: float = 0.03) -> np.ndarray:
-    """Normals with a little noise, as a sensor's would have (unit length)."""
-    n = normals + np.random.default_rng(seed).normal(0, sigma, normals.shape)
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
-
-
-def cylinder(
-    r: float = 0.03, height: float = 0.12, centre: tuple[float, float] = (0.0, 0.0)
-) -> tuple[np.ndarray, np.ndarray]:
-    """A vertical cylinder's side and top (points, outward normals), standing on z = 0."""
-    ang = np.linspace(0, 2 * np.pi, int(2 * np.pi * r / SPACING), endpoint=False)
-    hh = (np.arange(int(height / SPACING)) + 0.5) * SPACING
-    a, z = np.meshgrid(ang, hh)
-    side = np.column_stack([r * np.cos(a).ravel(), r * np.sin(a).ravel(), z.ravel()])
-    side_n = np.column_stack([np.cos(a).ravel(), np.sin(a).ravel(), np.zeros(a.size)])
-    g = np.arange(-r, r, SPACING)
-    x, y = np.meshgrid(g, g)
-    m = x**2 + y**2 <= r * r
-    top = np.column_stack([x[m], y[m], np.full(m.sum(), height)])
-    pts = np.vstack([side, top])
-    pts[:, :2] += centre
-    return pts, np.vstack([side_n, np.tile([0.0, 0.0, 1.0], (len(top), 1))])
-
-
-def plate(
-    origin: np.ndarray, du: np.ndarray, dv: np.ndarray, normal: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """A rectangle origin + s du + t dv (s, t in [0, 1]) of points with one normal."""
-    nu = max(1, int(np.linalg.norm(du) / SPACING))
-    nv = max(1, int(np.linalg.norm(dv) / SPACING))
-    s, t = np.meshgrid((np.arange(nu) + 0.5) / nu, (np.arange(nv) + 0.5) / nv)
-    pts = origin + s.ravel()[:, None] * du + t.ravel()[:, None] * dv
-    return pts, np.tile(normal, (len(pts), 1))
-
-
-def box(
-    size: tuple[float, float, float], centre: tuple[float, float] = (0.0, 0.0)
-) -> tuple[np.ndarray, np.ndarray]:
-    """An axis-aligned box's four sides and top (points, outward normals) on z = 0."""
-    sx, sy, sz = size
-    o = np.array([centre[0] - sx / 2, centre[1] - sy / 2, 0.0])
-    X, Y, Z = np.eye(3)
-    faces = [
-        plate(o + sx * X, sy * Y, sz * Z, X),
-        plate(o, sy * Y, sz * Z, -X),
-        plate(o + sy * Y, sx * X, sz * Z, Y),
-        plate(o, sx * X, sz * Z, -Y),
-        plate(o + sz * Z, sx * X, sy * Y, Z),
-    ]
-    return np.vstack([f[0] for f in faces]), np.vstack([f[1] for f in faces])
 
 
 def detect(target, normals, others=(), seed=0, settings=S) -> list[Grasp]:
@@ -145,9 +80,6 @@ def finger_corners(g: Grasp) -> np.ndarray:
             for a in (0.0, -HAND.finger_length):
                 out.append(tips + h * g.axis + c * g.closing + a * g.approach)
     return np.array(out)
-
-
-# --- cylinder ------------------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module")
@@ -301,9 +233,6 @@ def test_a_lying_cylinder_is_grasped_across_its_girth_from_along_its_axis_only_t
         assert not in_fingers(g, table()).any() and finger_corners(g)[:, 2].min() > 0.0
 
 
-# --- boxes ---------------------------------------------------------------------------------
-
-
 def test_narrow_box_closes_across_its_small_faces():
     pts, n = box((0.05, 0.03, 0.10))
     grasps = detect(pts, n)
@@ -325,9 +254,6 @@ def test_wide_box_has_no_grasp_wider_than_the_hand():
     # Across any face it is 12 cm: nothing may close there.
     for g in grasps:
         assert np.max(np.abs(g.closing)) < math.cos(FRICTION)
-
-
-# --- antipodal test ------------------------------------------------------------------------
 
 
 def two_plates(tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -408,9 +334,6 @@ def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
     assert [g.pose.tobytes() for g in unflagged] == [g.pose.tobytes() for g in free]
 
 
-# --- clutter -------------------------------------------------------------------------------
-
-
 def test_neighbour_blocks_fingers():
     pts, n = cylinder()
     # A 4 x 4 x 10 cm box 1 cm from the cylinder's side (+x).
@@ -456,9 +379,6 @@ def test_without_side_clearance_the_fingers_may_graze_the_object():
     )
 
 
-# --- determinism ---------------------------------------------------------------------------
-
-
 def test_same_seed_same_grasps():
     pts, n = cylinder()
     a, b = detect(pts, n, seed=3), detect(pts, n, seed=3)
@@ -474,115 +394,3 @@ def test_same_seed_same_grasps():
 
 def test_tiny_target_gives_nothing():
     assert detect_grasps(np.zeros((2, 3)), np.zeros((2, 3)), table()) == []
-
-
-# --- fast paths against the direct computation ---------------------------------------------
-
-
-def local_setup(target: np.ndarray, normals: np.ndarray, n_samples: int, seed: int = 1):
-    """Samples, their frames, orientations and closing grid, as detect_grasps builds them."""
-    idx = sample_indices(len(target), n_samples, np.random.default_rng(seed))
-    normal, axis = local_frames(target, normals, idx, S)
-    return target[idx], normal, axis, orientation_angles(S.gpd_orientations), ClosingGrid(HAND, S)
-
-
-def test_pruned_tips_equal_the_direct_computation():
-    pts, n = cylinder()
-    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
-    cloud = np.vstack([table(), other, pts])
-    samples, normal, axis, angles, grid = local_setup(pts, noisy(n), 120)
-    regions = hand_regions(HAND, S)
-    sid, _, h, u, v = slab_pairs(cloud, samples, normal, axis, regions)
-    direct = deepest_tips(h, u, v, sid, len(samples), angles, grid, HAND, S)
-    want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
-    pairs = CoarsePairs(cloud, samples, normal, axis, regions)
-    pruned = pruned_tips(pairs, samples, normal, axis, angles, grid, HAND, S, regions, want)
-    free = np.isfinite(direct) & want[:, :, None]
-    assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur
-    np.testing.assert_array_equal(np.isfinite(pruned), free)
-    np.testing.assert_allclose(pruned[free], direct[free], rtol=0, atol=1e-6)
-
-
-def test_antipodal_possible_never_rules_out_a_passing_frame():
-    pts, n = cylinder()
-    normals = noisy(n)
-    samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, _, h, u, v, nu, nv = pad_pairs(pts, normals, samples, normal, axis, HAND)
-    possible = antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, HAND, S).ravel()
-    rng = np.random.default_rng(3)
-    passed = np.zeros(len(possible), bool)
-    for _ in range(30):  # any placement, any depth the collision test could give
-        offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
-        tip = rng.uniform(S.gpd_init_bite, HAND.finger_length - S.gpd_clearance, len(possible))
-        _, ok, _ = closing_region(
-            h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), HAND, S
-        )
-        passed |= ok
-    assert passed.sum() > 50 and not possible.all()
-    assert not (passed & ~possible).any()
-
-
-def test_range_max_matches_a_direct_max():
-    rng = np.random.default_rng(0)
-    table_ = rng.normal(size=(37, 5)).astype(np.float32)
-    widest = 9
-    range_max = RangeMax(table_, widest)
-    lo = rng.integers(0, 37, 2000)
-    hi = np.minimum(lo + rng.integers(0, widest, 2000), 36)
-    col = rng.integers(0, 5, 2000)
-    expected = [table_[a : b + 1, c].max() for a, b, c in zip(lo, hi, col, strict=True)]
-    np.testing.assert_array_equal(range_max(lo, hi, col), expected)
-
-
-def test_voxel_groups_hold_each_point_once_within_its_radius():
-    pts = np.random.default_rng(0).uniform(-0.1, 0.1, (5000, 3))
-    vox = VoxelGroups(pts, 0.01)
-    parent, members = vox.members(np.arange(len(vox.starts)))
-    np.testing.assert_array_equal(np.sort(members), np.arange(len(pts)))
-    for axis in range(3):  # each group fits in one 1 cm cube
-        x = vox.points[members, axis]
-        span = np.maximum.reduceat(x, vox.starts) - np.minimum.reduceat(x, vox.starts)
-        assert span.max() < 0.01
-    spread = np.linalg.norm(vox.points[members] - vox.points[vox.rep[parent]], axis=1)
-    assert (spread <= vox.radius[parent]).all()
-
-
-def test_detector_equals_the_direct_computation():
-    # detect_grasps' shortcuts (the antipodal bound, voxel-pruned collisions, the cropped and
-    # de-duplicated scene) change nothing: the same grasps as deepest_tips over every frame
-    # and every (sample, scene point) pair, then the antipodal test. Without re-centring,
-    # which test_off_centre_hands_are_turned_and_shifted_onto_their_patch covers.
-    given = GraspSettings(gpd_samples=200, gpd_recentre=0.0)
-    pts, n = cylinder()
-    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
-    normals, target = noisy(n), pts.astype(np.float32).astype(np.float64)
-    scene = np.vstack([table(), pts, other]).astype(np.float32)
-    fast = detect_grasps(target, normals, scene, given, np.random.default_rng(5))
-
-    hand = cleared_hand(HAND, given.side_clearance)  # the hand the detector tests
-
-    centre = 0.5 * (target.min(axis=0) + target.max(axis=0))
-    tgt = target - centre
-    idx = sample_indices(len(tgt), given.gpd_samples, np.random.default_rng(5))
-    normal, axis = local_frames(tgt, normals, idx, given)
-    angles, grid = orientation_angles(given.gpd_orientations), ClosingGrid(hand, given)
-    cloud = np.vstack([scene - centre, tgt])
-    sid, _, h, u, v = slab_pairs(cloud, tgt[idx], normal, axis, hand_regions(hand, given))
-    tips = deepest_tips(h, u, v, sid, len(idx), angles, grid, hand, given).reshape(
-        -1, len(grid.offsets)
-    )
-    has, k = middle_placement(np.isfinite(tips))
-    offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
-    tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, _, th, tu, tv, nu, nv = pad_pairs(tgt, normals, tgt[idx], normal, axis, hand)
-    width, ok, centred = closing_region(
-        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, hand, given
-    )
-    good = np.flatnonzero(ok & has)
-    poses = grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], hand)
-    poses[:, :3, 3] += centre
-
-    assert len(fast) == len(good) > 50
-    np.testing.assert_allclose([g.pose for g in fast], poses, rtol=0, atol=1e-6)
-    np.testing.assert_allclose([g.width for g in fast], width[good], rtol=0, atol=1e-6)
-    assert [g.pads_centred for g in fast] == centred[good].tolist()
