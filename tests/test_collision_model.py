@@ -58,6 +58,26 @@ def test_body_frames_match_the_simulated_links():
                 assert gap.min() < -radius + 1e-6, name
 
 
+def test_the_simulated_gripper_is_the_hand_grasp_detection_tests():
+    """`dims.GRIPPER_HAND`, the boxes grasp detection tests, is the simulated gripper: its
+    fingers' plates and pads (half extents along the hand axis, the closing axis and the
+    approach), its housing across and along the hand axis, and no longer than the palm."""
+    m = build_sim_model(None)
+    hand = dims.GRIPPER_HAND
+    for side in ("left", "right"):
+        finger = m.geom_size[m.geom(f"gripper/finger_{side}").id]
+        pad = m.geom_size[m.geom(f"gripper/pad_{side}").id]
+        assert np.allclose(
+            finger, [hand.finger_width / 2, hand.finger_thickness / 2, hand.finger_length / 2]
+        )
+        assert np.allclose(pad, [hand.pad_width / 2, hand.pad_thickness / 2, hand.pad_depth / 2])
+    housing = m.geom_size[m.geom("gripper/housing").id]
+    assert np.allclose(housing[:2], [hand.palm_depth / 2, hand.palm_width / 2])
+    assert 2 * housing[2] <= hand.palm_length
+    finger_joint = m.joint("finger_left")
+    assert np.isclose(2 * m.jnt_range[finger_joint.id][1], hand.width_max)
+
+
 def test_keepout_boxes_hold_every_part_of_the_scooter_the_arm_can_reach():
     # What the planner avoids must hold what the simulator collides with. Points over every
     # part from the posts up (and over the tiller and the basket) lie in some box: a box's
