@@ -200,7 +200,7 @@ def test_carried_shape_fills_in_the_unseen_back_of_a_can():
 def test_the_middle_of_a_box_whose_top_was_seen_in_part_is_the_middle_of_its_seen_width():
     """A 6 x 19 x 25 cm box standing on the 100 cm shelf, seen from the front (-x): its front
     face whole up to 5 cm under its top; above that, and of its top, only the 15 cm nearest
-    its +y end (as the cameras saw the kitchen's cereal box). The half turn about the middle
+    its +y end, as the cameras see the kitchen's cereal box. The half turn about the middle
     of that top carries the box on past its +y end, so the carried shape's middle lies 2 cm
     off the box's. The middle a place turns it about must be the box's own, within 5 mm."""
     middle = np.array([1.60, -0.31])
@@ -231,7 +231,8 @@ def test_surface_front_walls_in_a_counter_front_the_view_cut_off():
     y = -0.8 m, but right of y = -0.5 m the view's edge cuts the top on a slant (the top's
     nearest seen point there lies up to 30 cm deeper) and the front below it is not seen.
     The wall must stand at the nearest seen edge across the whole seen width, from just
-    under the top down to the floor's clearance, where the upper arm met the unseen front."""
+    under the top down to the floor's clearance, where a stow's upper arm would meet the
+    unseen front."""
     xs, ys = np.meshgrid(np.arange(1.40, 2.0, 0.01), np.arange(-0.8, 0.38, 0.01))
     top = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 0.87)]
     top = top[top[:, 0] >= 1.40 + np.maximum(0.0, -0.5 - top[:, 1])]  # the slanted view edge
@@ -246,7 +247,7 @@ def test_surface_front_walls_in_a_counter_front_the_view_cut_off():
     assert np.diff(np.unique(wall[:, 1])).max() <= 0.02 + 1e-9
     assert wall[:, 2].max() < 0.87 - 0.015  # below the top, which the hand may set things on
     assert wall[:, 2].min() >= FLOOR_CLEARANCE
-    upper_arm = np.array([1.36, -0.58, 0.84])  # where the stow's upper arm met the counter
+    upper_arm = np.array([1.36, -0.58, 0.84])  # where a stow's upper arm meets the counter
     assert np.linalg.norm(cloud - upper_arm, axis=1).min() > 0.06  # its 6 cm sphere: clear
     assert np.linalg.norm(wall - upper_arm, axis=1).min() < 0.06  # not of the wall
     assert len(surface_front(cloud, 0.0, 0.015)) == 0  # the floor has no front
