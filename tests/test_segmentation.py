@@ -13,12 +13,11 @@ import pytest
 
 from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.planes import min_plane_inliers, remove_horizontal_planes
 from laserpick.pipeline.segment import (
     NO_OBJECT,
     NOTHING_SEEN,
     euclidean_clusters,
-    min_plane_inliers,
-    remove_horizontal_planes,
     segment_target,
 )
 from laserpick.robot.sim.scenes import parse_scene
