@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.pipeline.gpd import detect_grasps
 from laserpick.settings import get_settings
 
 #: detect_grasps' stages, in its order (see its `timings`); a stage that did not run counts 0.

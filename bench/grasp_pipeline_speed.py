@@ -18,7 +18,7 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasping import GraspSet, find_grasps, plan_first
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps, plan_first
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.truth import capture
 from laserpick.types import Failure

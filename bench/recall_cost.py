@@ -22,7 +22,7 @@ import numpy as np
 import laserpick.pipeline.recall as recall
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene

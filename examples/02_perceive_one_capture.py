@@ -21,7 +21,7 @@ import sys
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.pipeline.grasping import find_grasps
+from laserpick.pipeline.grasp_choice import find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.recording import RecordingError, read_recording
 from laserpick.types import Failure

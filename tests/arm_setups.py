@@ -14,7 +14,7 @@ from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.plan import cartesian_line
 from laserpick.robot.sim.robot import SimRobot

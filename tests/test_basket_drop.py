@@ -15,7 +15,7 @@ from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene

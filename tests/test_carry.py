@@ -9,8 +9,8 @@ from arm_setups import isolation_robot, pick_object
 
 from laserpick.behaviours import Behaviours, Held
 from laserpick.description import dims
-from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import tcp_pose
+from laserpick.description.shapes import body_frames
 from laserpick.pipeline.collision import SPHERES, CollisionChecker, sphere_centres
 from laserpick.types import Grasp, Trajectory
 

@@ -136,7 +136,7 @@ def too_long(path: Path) -> list[str]:
 #: "stop 57", "round 12", "seed 1's soda can", "seed 200 trial 1", and a word of 7-40 hex
 #: digits with a letter and a digit (a commit).
 HISTORY = re.compile(
-    r"(?<![-\w])(stop|round)s? \d+\b|\bseed \d+('s| trial)|"
+    r"(?<![-\w])(stop|round)s? \d+\b(?!-|\.\d| ?(mm|cm|m|s|ms|N)\b)|\bseed \d+('s| trial)|"
     r"\b(?=[0-9a-f]*\d)(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}\b",
     re.IGNORECASE,
 )

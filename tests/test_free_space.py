@@ -16,7 +16,7 @@ from laserpick.pipeline.free_space import (
     hidden,
     seen_free,
 )
-from laserpick.pipeline.grasping import GraspSet, find_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
 from laserpick.settings import GraspSettings
 from laserpick.types import (
@@ -114,7 +114,7 @@ def test_a_finger_in_the_box_unseen_back_is_refused_one_beside_it_is_not():
     # From above, closing front-back: the far finger goes down behind the box, unseen.
     through = _side_grasp(along_x, down)
     assert fingers_seen_free([across, through], [frame], S).tolist() == [True, False]
-    probes = finger_probes(through.pose[None], S)[0]
+    probes = finger_probes(through.pose[None])[0]
     far = probes[:, 0] > BOX_CENTRE[0]
     assert far.sum() == len(probes) // 2
     free = seen_free(probes, [frame], TOL)

@@ -1,7 +1,7 @@
 """GPD-style grasp candidates on synthetic point clouds (no simulator).
 
-Shapes are sampled on a 3 mm grid with exact outward normals plus a little noise, standing on
-a 4 mm grid of table points at z = 0. Frames: `base`-like, z up, metres.
+The shapes (`gpd_shapes`) are sampled on a 3 mm grid with exact outward normals plus a little
+noise, standing on a 4 mm grid of table points at z = 0. Frames: `base`-like, z up, metres.
 """
 
 from __future__ import annotations
@@ -10,73 +10,27 @@ import math
 
 import numpy as np
 import pytest
+from gpd_shapes import box, cylinder, noisy, plate, table
+from scipy.spatial import cKDTree
 
-from laserpick.pipeline import grasp_detect as gd
-from laserpick.pipeline.grasp_detect import detect_grasps
+from laserpick.description.dims import GRIPPER_HAND
+from laserpick.pipeline.gpd import CandidateSearch, detect_grasps
+from laserpick.pipeline.gpd.antipodal import (
+    guesses_face_seen,
+)
+from laserpick.pipeline.gpd.frames import (
+    local_frames,
+    sample_indices,
+    tilted_frames,
+)
+from laserpick.pipeline.gpd.hand import cleared_hand
+from laserpick.pipeline.gpd.recentre import patch_moves
 from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 
 S = GraspSettings()
-SPACING = 0.003  #: m between object points
+HAND = GRIPPER_HAND
 FRICTION = math.radians(S.gpd_friction_deg)
-
-
-def table(half: float = 0.3, spacing: float = 0.004) -> np.ndarray:
-    g = np.arange(-half, half, spacing)
-    x, y = np.meshgrid(g, g)
-    return np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-
-
-def noisy(normals: np.ndarray, seed: int = 7, sigma: float = 0.03) -> np.ndarray:
-    """Normals with a little noise, as a sensor's would have (unit length)."""
-    n = normals + np.random.default_rng(seed).normal(0, sigma, normals.shape)
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
-
-
-def cylinder(
-    r: float = 0.03, height: float = 0.12, centre: tuple[float, float] = (0.0, 0.0)
-) -> tuple[np.ndarray, np.ndarray]:
-    """A vertical cylinder's side and top (points, outward normals), standing on z = 0."""
-    ang = np.linspace(0, 2 * np.pi, int(2 * np.pi * r / SPACING), endpoint=False)
-    hh = (np.arange(int(height / SPACING)) + 0.5) * SPACING
-    a, z = np.meshgrid(ang, hh)
-    side = np.column_stack([r * np.cos(a).ravel(), r * np.sin(a).ravel(), z.ravel()])
-    side_n = np.column_stack([np.cos(a).ravel(), np.sin(a).ravel(), np.zeros(a.size)])
-    g = np.arange(-r, r, SPACING)
-    x, y = np.meshgrid(g, g)
-    m = x**2 + y**2 <= r * r
-    top = np.column_stack([x[m], y[m], np.full(m.sum(), height)])
-    pts = np.vstack([side, top])
-    pts[:, :2] += centre
-    return pts, np.vstack([side_n, np.tile([0.0, 0.0, 1.0], (len(top), 1))])
-
-
-def plate(
-    origin: np.ndarray, du: np.ndarray, dv: np.ndarray, normal: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """A rectangle origin + s du + t dv (s, t in [0, 1]) of points with one normal."""
-    nu = max(1, int(np.linalg.norm(du) / SPACING))
-    nv = max(1, int(np.linalg.norm(dv) / SPACING))
-    s, t = np.meshgrid((np.arange(nu) + 0.5) / nu, (np.arange(nv) + 0.5) / nv)
-    pts = origin + s.ravel()[:, None] * du + t.ravel()[:, None] * dv
-    return pts, np.tile(normal, (len(pts), 1))
-
-
-def box(
-    size: tuple[float, float, float], centre: tuple[float, float] = (0.0, 0.0)
-) -> tuple[np.ndarray, np.ndarray]:
-    """An axis-aligned box's four sides and top (points, outward normals) on z = 0."""
-    sx, sy, sz = size
-    o = np.array([centre[0] - sx / 2, centre[1] - sy / 2, 0.0])
-    X, Y, Z = np.eye(3)
-    faces = [
-        plate(o + sx * X, sy * Y, sz * Z, X),
-        plate(o, sy * Y, sz * Z, -X),
-        plate(o + sy * Y, sx * X, sz * Z, Y),
-        plate(o, sx * X, sz * Z, -Y),
-        plate(o + sz * Z, sx * X, sy * Y, Z),
-    ]
-    return np.vstack([f[0] for f in faces]), np.vstack([f[1] for f in faces])
 
 
 def detect(target, normals, others=(), seed=0, settings=S) -> list[Grasp]:
@@ -89,7 +43,7 @@ def detect(target, normals, others=(), seed=0, settings=S) -> list[Grasp]:
 def hand_coords(g: Grasp, pts: np.ndarray) -> np.ndarray:
     """Points in the grasp's frame (hand axis, closing, approach), origin at the fingertips'
     centre line (the TCP moved pad_depth / 2 forward)."""
-    tips = g.position + g.approach * S.pad_depth / 2
+    tips = g.position + g.approach * HAND.pad_depth / 2
     return (pts - tips) @ g.pose[:3, :3]
 
 
@@ -97,36 +51,35 @@ def in_fingers(g: Grasp, pts: np.ndarray, grow: float = 0.0) -> np.ndarray:
     """Mask of points inside either finger box (pad plus plate) of the open hand, each box
     grown by `grow` (m) on its four sides (not at the tip or the root)."""
     h, c, a = hand_coords(g, pts).T
-    thick = S.pad_thickness + S.finger_thickness
-    lateral = (np.abs(c) >= S.width_max / 2 - grow) & (np.abs(c) <= S.width_max / 2 + thick + grow)
-    across = np.abs(h) <= S.finger_width / 2 + grow
-    return lateral & across & (a <= 0) & (a >= -S.finger_length)
+    thick = HAND.pad_thickness + HAND.finger_thickness
+    lateral = (np.abs(c) >= HAND.width_max / 2 - grow) & (
+        np.abs(c) <= HAND.width_max / 2 + thick + grow
+    )
+    across = np.abs(h) <= HAND.finger_width / 2 + grow
+    return lateral & across & (a <= 0) & (a >= -HAND.finger_length)
 
 
 def in_palm(g: Grasp, pts: np.ndarray, grow: float = 0.0) -> np.ndarray:
     """Mask of points inside the palm box, grown by `grow` (m) on its four sides."""
     h, c, a = hand_coords(g, pts).T
     return (
-        (np.abs(c) <= S.palm_width / 2 + grow)
-        & (np.abs(h) <= S.palm_depth / 2 + grow)
-        & (a <= -S.finger_length)
-        & (a >= -S.finger_length - S.palm_length)
+        (np.abs(c) <= HAND.palm_width / 2 + grow)
+        & (np.abs(h) <= HAND.palm_depth / 2 + grow)
+        & (a <= -HAND.finger_length)
+        & (a >= -HAND.finger_length - HAND.palm_length)
     )
 
 
 def finger_corners(g: Grasp) -> np.ndarray:
     """The 16 corners of both finger boxes in `base`."""
-    thick = S.pad_thickness + S.finger_thickness
-    tips = g.position + g.approach * S.pad_depth / 2
+    thick = HAND.pad_thickness + HAND.finger_thickness
+    tips = g.position + g.approach * HAND.pad_depth / 2
     out = []
-    for h in (-S.finger_width / 2, S.finger_width / 2):
-        for c in (S.width_max / 2 + thick, -S.width_max / 2 - thick):
-            for a in (0.0, -S.finger_length):
+    for h in (-HAND.finger_width / 2, HAND.finger_width / 2):
+        for c in (HAND.width_max / 2 + thick, -HAND.width_max / 2 - thick):
+            for a in (0.0, -HAND.finger_length):
                 out.append(tips + h * g.axis + c * g.closing + a * g.approach)
     return np.array(out)
-
-
-# --- cylinder ------------------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module")
@@ -144,7 +97,7 @@ def test_cylinder_has_grasps_closing_horizontally_through_its_axis(cylinder_gras
         assert abs(g.closing[2]) <= math.sin(FRICTION + math.radians(3))
         c = g.closing[:2] / np.linalg.norm(g.closing[:2])
         p = g.position[:2]
-        near = 0.03 * math.sin(FRICTION) + S.pad_width / 2
+        near = 0.03 * math.sin(FRICTION) + HAND.pad_width / 2
         assert abs(p[0] * c[1] - p[1] * c[0]) < near
 
 
@@ -153,7 +106,7 @@ def test_cylinder_width_is_its_diameter(cylinder_grasps):
     assert np.median(widths) == pytest.approx(0.06, abs=0.005)
     level = [g.width for g in cylinder_grasps if abs(g.closing[2]) < math.sin(math.radians(5))]
     assert level and np.allclose(level, 0.06, atol=0.005)
-    assert widths.max() <= S.width_max
+    assert widths.max() <= HAND.width_max
 
 
 def test_cylinder_grasps_stay_above_the_table(cylinder_grasps):
@@ -200,17 +153,17 @@ def test_off_centre_hands_are_turned_and_shifted_onto_their_patch():
     would meet the can along their face."""
     pts, n = cylinder(r=0.033, height=0.122)
     normals, scene = noisy(n), np.vstack([table(), pts]).astype(np.float32)
-    s = gd.cleared_hand(S)
+    hand = cleared_hand(HAND, S.side_clearance)
     centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     tgt = pts - centre
-    tree = gd.cKDTree(tgt)
-    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(0))
-    normal, axis = gd.local_frames(tgt, normals, idx, s, tree)
-    hands = gd.Hands(tgt, normals, scene, centre, tree, s, None, lambda _: None)
-    found = hands.grasps(tgt[idx], normal, axis)
+    tree = cKDTree(tgt)
+    idx = sample_indices(len(tgt), S.gpd_samples, np.random.default_rng(0))
+    normal, axis = local_frames(tgt, normals, idx, S, tree)
+    search = CandidateSearch(tgt, normals, scene, centre, tree, hand, S, None, lambda _: None)
+    found = search.candidates(tgt[idx], normal, axis)
     above = np.flatnonzero(~found.centred & (found.poses[:, 2, 2] < -0.9))
     off = found.subset(above)
-    turn, shift = gd.patch_moves(hands, off)
+    turn, shift = patch_moves(tgt, normals, hand, S, off)
     moved = np.isfinite(shift)
     assert moved.mean() > 0.8
     # The turn levels the closing axis: it turns it by about as much as it leans.
@@ -246,7 +199,7 @@ def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():
     axis = np.cross(normal, rng.normal(size=(5, 3)))
     axis /= np.linalg.norm(axis, axis=1, keepdims=True)
     tilts = np.radians([0.0, 30.0, -60.0])
-    n2, a2 = gd.tilted_frames(normal, axis, tilts)
+    n2, a2 = tilted_frames(normal, axis, tilts)
     assert n2.shape == a2.shape == (15, 3)
     for t, beta in enumerate(tilts):
         rows = slice(5 * t, 5 * t + 5)
@@ -280,9 +233,6 @@ def test_a_lying_cylinder_is_grasped_across_its_girth_from_along_its_axis_only_t
         assert not in_fingers(g, table()).any() and finger_corners(g)[:, 2].min() > 0.0
 
 
-# --- boxes ---------------------------------------------------------------------------------
-
-
 def test_narrow_box_closes_across_its_small_faces():
     pts, n = box((0.05, 0.03, 0.10))
     grasps = detect(pts, n)
@@ -290,7 +240,7 @@ def test_narrow_box_closes_across_its_small_faces():
     for g in grasps:
         # Across the 3 cm or the 5 cm faces (width up to the friction cone's slant), never
         # across the 10 cm height.
-        assert g.width <= S.width_max
+        assert g.width <= HAND.width_max
         assert min(abs(g.width - 0.03), abs(g.width - 0.05)) < 0.012
         assert abs(g.closing[2]) < 0.5
     widths = np.array([g.width for g in grasps])
@@ -300,13 +250,10 @@ def test_narrow_box_closes_across_its_small_faces():
 def test_wide_box_has_no_grasp_wider_than_the_hand():
     pts, n = box((0.12, 0.12, 0.12))
     grasps = detect(pts, n)
-    assert all(0 < g.width <= S.width_max for g in grasps)
+    assert all(0 < g.width <= HAND.width_max for g in grasps)
     # Across any face it is 12 cm: nothing may close there.
     for g in grasps:
         assert np.max(np.abs(g.closing)) < math.cos(FRICTION)
-
-
-# --- antipodal test ------------------------------------------------------------------------
 
 
 def two_plates(tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -345,14 +292,14 @@ def test_a_pad_on_guessed_points_only_must_face_the_seen_ones():
     guessed = np.array([0, 1, 0, 1, 0, 0, 1, 1], bool)
     contacts = [(f, side, depth, guessed)]
     wider = [(np.array([0]), np.array([0]), np.array([0.010], np.float32), np.array([False]))]
-    ok = gd.guesses_face_seen(contacts + wider, 4)
+    ok = guesses_face_seen(contacts + wider, 4)
     # 0: the guessed pad (-4 mm) lies in front of the seen one (4-10 mm): refused.
     # 1: the guessed pad at 2 mm, the seen one at 4 mm: no overlap, refused; with the seen
     #    pad reaching 2 mm it is kept. 2: both seen: the rule does not apply.
     # 3: both pads guessed: nothing seen is held, refused.
     np.testing.assert_array_equal(ok, [False, False, True, False])
     reach = [(np.array([1]), np.array([0]), np.array([0.002], np.float32), np.array([False]))]
-    assert gd.guesses_face_seen(contacts + reach, 4)[1]
+    assert guesses_face_seen(contacts + reach, 4)[1]
 
 
 def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
@@ -374,8 +321,8 @@ def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
         """Whether the pads' seen and guessed points overlap in depth (the plates are flat:
         every point between the pads is a contact)."""
         h, c, a = hand_coords(g, pts).T
-        pad = (np.abs(h) < S.pad_width / 2) & (a <= 0) & (a >= -S.pad_depth)
-        pad &= np.abs(c) < S.width_max / 2
+        pad = (np.abs(h) < HAND.pad_width / 2) & (a <= 0) & (a >= -HAND.pad_depth)
+        pad &= np.abs(c) < HAND.width_max / 2
         on_seen, on_guess = a[pad & ~guessed], a[pad & guessed]
         return max(on_seen.min(), on_guess.min()) <= min(on_seen.max(), on_guess.max())
 
@@ -385,9 +332,6 @@ def test_a_guessed_plate_beside_the_seen_one_is_not_grasped_across_the_seam():
     assert {g.pose.tobytes() for g in ruled} <= {g.pose.tobytes() for g in free}
     unflagged = run(np.zeros(len(pts), bool))  # all seen: nothing changes
     assert [g.pose.tobytes() for g in unflagged] == [g.pose.tobytes() for g in free]
-
-
-# --- clutter -------------------------------------------------------------------------------
 
 
 def test_neighbour_blocks_fingers():
@@ -415,7 +359,7 @@ def test_the_hand_keeps_its_side_clearance_from_every_point():
         for cloud in (pts, other):
             assert not in_fingers(g, cloud, grow=near).any()
             assert not in_palm(g, cloud, grow=near).any()
-    assert max(g.width for g in grasps) <= S.width_max - 2 * S.side_clearance
+    assert max(g.width for g in grasps) <= HAND.width_max - 2 * S.side_clearance
 
 
 def test_without_side_clearance_the_fingers_may_graze_the_object():
@@ -435,9 +379,6 @@ def test_without_side_clearance_the_fingers_may_graze_the_object():
     )
 
 
-# --- determinism ---------------------------------------------------------------------------
-
-
 def test_same_seed_same_grasps():
     pts, n = cylinder()
     a, b = detect(pts, n, seed=3), detect(pts, n, seed=3)
@@ -453,113 +394,3 @@ def test_same_seed_same_grasps():
 
 def test_tiny_target_gives_nothing():
     assert detect_grasps(np.zeros((2, 3)), np.zeros((2, 3)), table()) == []
-
-
-# --- fast paths against the direct computation ---------------------------------------------
-
-
-def local_setup(target: np.ndarray, normals: np.ndarray, n_samples: int, seed: int = 1):
-    """Samples, their frames, orientations and closing grid, as detect_grasps builds them."""
-    idx = gd.sample_indices(len(target), n_samples, np.random.default_rng(seed))
-    normal, axis = gd.local_frames(target, normals, idx, S)
-    return target[idx], normal, axis, gd.orientation_angles(S.gpd_orientations), gd.ClosingGrid(S)
-
-
-def test_pruned_tips_equal_the_direct_computation():
-    pts, n = cylinder()
-    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
-    cloud = np.vstack([table(), other, pts])
-    samples, normal, axis, angles, grid = local_setup(pts, noisy(n), 120)
-    regions = gd.hand_regions(S)
-    sid, _, h, u, v = gd.slab_pairs(cloud, samples, normal, axis, regions)
-    direct = gd.deepest_tips(h, u, v, sid, len(samples), angles, grid, S)
-    want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
-    pairs = gd.CoarsePairs(cloud, samples, normal, axis, regions)
-    pruned = gd.pruned_tips(pairs, samples, normal, axis, angles, grid, S, regions, want)
-    free = np.isfinite(direct) & want[:, :, None]
-    assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur
-    np.testing.assert_array_equal(np.isfinite(pruned), free)
-    np.testing.assert_allclose(pruned[free], direct[free], rtol=0, atol=1e-6)
-
-
-def test_antipodal_possible_never_rules_out_a_passing_frame():
-    pts, n = cylinder()
-    normals = noisy(n)
-    samples, normal, axis, angles, grid = local_setup(pts, normals, 150)
-    sid, _, h, u, v, nu, nv = gd.pad_pairs(pts, normals, samples, normal, axis, S)
-    possible = gd.antipodal_possible(u, v, nu, nv, sid, len(samples), angles, grid, S).ravel()
-    rng = np.random.default_rng(3)
-    passed = np.zeros(len(possible), bool)
-    for _ in range(30):  # any placement, any depth the collision test could give
-        offset = rng.choice(grid.offsets, len(possible)).astype(np.float32)
-        tip = rng.uniform(S.gpd_init_bite, S.finger_length - S.gpd_clearance, len(possible))
-        _, ok, _ = gd.closing_region(
-            h, u, v, nu, nv, sid * len(angles), angles, offset, tip.astype(np.float32), S
-        )
-        passed |= ok
-    assert passed.sum() > 50 and not possible.all()
-    assert not (passed & ~possible).any()
-
-
-def test_range_max_matches_a_direct_max():
-    rng = np.random.default_rng(0)
-    table_ = rng.normal(size=(37, 5)).astype(np.float32)
-    widest = 9
-    range_max = gd.RangeMax(table_, widest)
-    lo = rng.integers(0, 37, 2000)
-    hi = np.minimum(lo + rng.integers(0, widest, 2000), 36)
-    col = rng.integers(0, 5, 2000)
-    expected = [table_[a : b + 1, c].max() for a, b, c in zip(lo, hi, col, strict=True)]
-    np.testing.assert_array_equal(range_max(lo, hi, col), expected)
-
-
-def test_voxel_groups_hold_each_point_once_within_its_radius():
-    pts = np.random.default_rng(0).uniform(-0.1, 0.1, (5000, 3))
-    vox = gd.VoxelGroups(pts, 0.01)
-    parent, members = vox.members(np.arange(len(vox.starts)))
-    np.testing.assert_array_equal(np.sort(members), np.arange(len(pts)))
-    for axis in range(3):  # each group fits in one 1 cm cube
-        x = vox.points[members, axis]
-        span = np.maximum.reduceat(x, vox.starts) - np.minimum.reduceat(x, vox.starts)
-        assert span.max() < 0.01
-    spread = np.linalg.norm(vox.points[members] - vox.points[vox.rep[parent]], axis=1)
-    assert (spread <= vox.radius[parent]).all()
-
-
-def test_detector_equals_the_direct_computation():
-    # detect_grasps' shortcuts (the antipodal bound, voxel-pruned collisions, the cropped and
-    # de-duplicated scene) change nothing: the same grasps as deepest_tips over every frame
-    # and every (sample, scene point) pair, then the antipodal test. Without re-centring,
-    # which test_off_centre_hands_are_turned_and_shifted_onto_their_patch covers.
-    given = GraspSettings(gpd_samples=200, gpd_recentre=0.0)
-    pts, n = cylinder()
-    other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
-    normals, target = noisy(n), pts.astype(np.float32).astype(np.float64)
-    scene = np.vstack([table(), pts, other]).astype(np.float32)
-    fast = detect_grasps(target, normals, scene, given, np.random.default_rng(5))
-
-    s = gd.cleared_hand(given)  # the hand the detector tests
-
-    centre = 0.5 * (target.min(axis=0) + target.max(axis=0))
-    tgt = target - centre
-    idx = gd.sample_indices(len(tgt), s.gpd_samples, np.random.default_rng(5))
-    normal, axis = gd.local_frames(tgt, normals, idx, s)
-    angles, grid = gd.orientation_angles(s.gpd_orientations), gd.ClosingGrid(s)
-    cloud = np.vstack([scene - centre, tgt])
-    sid, _, h, u, v = gd.slab_pairs(cloud, tgt[idx], normal, axis, gd.hand_regions(s))
-    tips = gd.deepest_tips(h, u, v, sid, len(idx), angles, grid, s).reshape(-1, len(grid.offsets))
-    has, k = gd.middle_placement(np.isfinite(tips))
-    offset = np.where(has, grid.offsets[k], np.nan).astype(np.float32)
-    tip = np.where(has, tips[np.arange(len(tips)), k], np.nan).astype(np.float32)
-    tsid, _, th, tu, tv, nu, nv = gd.pad_pairs(tgt, normals, tgt[idx], normal, axis, s)
-    width, ok, centred = gd.closing_region(
-        th, tu, tv, nu, nv, tsid * len(angles), angles, offset, tip, s
-    )
-    good = np.flatnonzero(ok & has)
-    poses = gd.grasp_poses(tgt[idx], normal, axis, angles, good, offset[good], tip[good], s)
-    poses[:, :3, 3] += centre
-
-    assert len(fast) == len(good) > 50
-    np.testing.assert_allclose([g.pose for g in fast], poses, rtol=0, atol=1e-6)
-    np.testing.assert_allclose([g.width for g in fast], width[good], rtol=0, atol=1e-6)
-    assert [g.pads_centred for g in fast] == centred[good].tolist()

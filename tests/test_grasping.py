@@ -8,9 +8,10 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasp_detect import detect_grasps
-from laserpick.pipeline.grasping import GraspSet, find_grasps, vertical_grasp
+from laserpick.pipeline.gpd import detect_grasps
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
+from laserpick.pipeline.strategies import vertical_grasp
 from laserpick.settings import get_settings
 from laserpick.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
 
@@ -117,7 +118,7 @@ def test_a_vertical_grasp_on_a_cup_seen_from_the_front_clears_its_far_rim():
     # The cup's far and near sides along the closing axis, from the TCP.
     c = g.closing[:2] / np.linalg.norm(g.closing[:2])
     reach = np.abs((pts[:, :2] - g.position[:2]) @ c).max()
-    assert reach + s.grasp.side_clearance <= s.grasp.width_max / 2
+    assert reach + s.grasp.side_clearance <= dims.GRIPPER_HAND.width_max / 2
 
 
 def test_an_object_seen_from_one_side_is_completed_by_symmetry():

@@ -21,8 +21,8 @@ from laserpick.behaviours import (
 )
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
-from laserpick.description.collision import body_frames
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.description.shapes import body_frames
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import (
     SPHERES,

@@ -13,12 +13,11 @@ import pytest
 
 from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
+from laserpick.pipeline.planes import min_plane_inliers, remove_horizontal_planes
 from laserpick.pipeline.segment import (
     NO_OBJECT,
     NOTHING_SEEN,
     euclidean_clusters,
-    min_plane_inliers,
-    remove_horizontal_planes,
     segment_target,
 )
 from laserpick.robot.sim.scenes import parse_scene
@@ -312,9 +311,8 @@ def test_a_floor_filling_the_view_is_found_around_the_mark():
 def test_object_tops_in_line_are_not_a_surface():
     """A plane's band cuts through whatever crosses it. Here a bowl's rim and the top of a
     box 8 cm beside it stand 6 cm above the table, in one band: more points than a plane
-    needs, but only the box's top faces up. That is not a surface. Counted whole, it was the
-    bowl's support, 6 cm above the table, and the rim went with it (the kitchen's bowl on
-    the counter: the gripper closed above the rim)."""
+    needs, but only the box's top faces up. That is not a surface. Counted whole, it would
+    be the bowl's support, 6 cm above the table, and the rim would go with it."""
     rng = np.random.default_rng(0)
     g = np.arange(-0.3, 0.3, 0.003)
     x, y = np.meshgrid(g, g)

@@ -15,6 +15,7 @@ from laserpick.settings import GraspSettings
 from laserpick.types import Grasp
 
 S = GraspSettings()
+HAND = dims.GRIPPER_HAND
 
 
 def _pose(approach, closing, p=(1.5, 0.0, 0.5)) -> np.ndarray:
@@ -25,9 +26,7 @@ def _pose(approach, closing, p=(1.5, 0.0, 0.5)) -> np.ndarray:
     return T
 
 
-def test_hand_geometry_settings_match_the_gripper():
-    assert pytest.approx(dims.GRIPPER_STROKE) == S.width_max
-    assert pytest.approx(dims.GRIPPER_FINGER_LENGTH) == S.finger_length
+def test_joint_distance_max_is_the_largest_wrapped_distance():
     assert S.joint_distance_max == pytest.approx(math.pi * math.sqrt(6), abs=1e-3)
 
 
@@ -70,17 +69,17 @@ def test_approach_factor_eq5_in_an_x_forward_frame():
 def test_sample_factor_eq6():
     g_b = np.array([1.0, 0.0, 0.5])
     sample = np.array([[1.02, 0.0, 0.5], [1.2, 0.0, 0.5]])  # nearest 0.02 m away
-    assert sel.sample_factor(g_b, sample, S) == pytest.approx(1 - 0.02 / 0.05)
-    assert sel.sample_factor(g_b, sample + [1.0, 0, 0], S) == 0.0  # beyond l
-    assert sel.sample_factor(g_b, np.zeros((0, 3)), S) == 0.0
+    assert sel.sample_factor(g_b, sample) == pytest.approx(1 - 0.02 / 0.05)
+    assert sel.sample_factor(g_b, sample + [1.0, 0, 0]) == 0.0  # beyond l
+    assert sel.sample_factor(g_b, np.zeros((0, 3))) == 0.0
 
 
 def test_g_b_is_the_hands_bottom_between_the_finger_roots():
     # A top grasp (approach straight down) with its TCP at z 0.5: the fingertips are
     # pad_depth / 2 below it, the finger roots finger_length above the tips.
     g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0]), width=0.05)
-    tips_z = 0.5 - S.pad_depth / 2
-    assert sel.hand_bottom(g.pose, S) == pytest.approx([1.5, 0.0, tips_z + S.finger_length])
+    tips_z = 0.5 - HAND.pad_depth / 2
+    assert sel.hand_bottom(g.pose) == pytest.approx([1.5, 0.0, tips_z + HAND.finger_length])
 
 
 def test_cs_prefers_the_hand_a_can_fills_to_pads_on_its_top_edge():
@@ -96,10 +95,10 @@ def test_cs_prefers_the_hand_a_can_fills_to_pads_on_its_top_edge():
     can = np.vstack([side, top])
     rim = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p=(1.5, 0.0, 0.582)), width=0.066)
     deep = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p=(1.5, 0.0, 0.552)), width=0.066)
-    cs = [sel.sample_factor(sel.hand_bottom(g.pose, S), can, S) for g in (rim, deep)]
+    cs = [sel.sample_factor(sel.hand_bottom(g.pose), can) for g in (rim, deep)]
     # The rim grasp's bottom stands 3.9 cm above the top: Cs = 1 - 0.039 / 0.05.
     assert cs[0] == pytest.approx(
-        1 - (S.finger_length - S.pad_depth / 2) / S.finger_length, abs=0.01
+        1 - (HAND.finger_length - HAND.pad_depth / 2) / HAND.finger_length, abs=0.01
     )
     assert cs[1] > cs[0] + 0.5
 
@@ -112,7 +111,7 @@ def test_mark_factor_eq7():
 
 def test_score_multiplies_the_factors_and_needs_ik():
     g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0]), width=0.010, ik=np.full(6, 0.1))
-    g_b = sel.hand_bottom(g.pose, S)
+    g_b = sel.hand_bottom(g.pose)
     scored = sel.score(g, q_now=np.zeros(6), sample=g_b[None, :], mark=g_b)
     f = scored.scores
     assert f is not None
@@ -142,7 +141,7 @@ def _scored(p, total_like: float) -> Grasp:
     # A grasp whose only imperfect factor is Cj, so its score is easy to set.
     g = Grasp(pose=_pose([0, 0, -1], [0, 1, 0], p), width=0.04, ik=np.zeros(6))
     q_now = np.array([(1 - total_like) * S.joint_distance_max, 0, 0, 0, 0, 0])
-    g_b = sel.hand_bottom(g.pose, S)
+    g_b = sel.hand_bottom(g.pose)
     return sel.score(g, q_now=q_now, sample=g_b[None, :], mark=g_b)
 
 

@@ -15,7 +15,7 @@ from driving import drive_straight
 from laserpick.behaviours import PAST_THE_OPENING, Held, Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.truth import SimTruth

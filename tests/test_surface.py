@@ -111,8 +111,7 @@ def test_place_moves_back_from_the_front_edge(surfaces):
 
 def test_a_mark_on_the_floor_is_not_moved_back(surfaces):
     """The floor has no edge to fall from: its nearest seen boundary is where the cameras'
-    view begins. A mark 3 cm past that stays where it is (moved back 10 cm from it, a cereal
-    box was set down 5 cm from its mark)."""
+    view begins. A mark 3 cm past that stays where it is, not moved back 10 cm from it."""
     surf, cloud, y0 = next(s for s in surfaces if s[0].kind == "floor")
     y = float(surf.xy[1]) - y0
     pts = cloud.points

@@ -14,7 +14,7 @@ from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasping import GraspSet, plan_first
+from laserpick.pipeline.grasp_choice import GraspSet, plan_first
 from laserpick.pipeline.plan import PickPlan, cartesian_line, timed
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.types import Failure, Grasp, Trajectory

@@ -60,8 +60,8 @@ UR5_HOME_Q = np.array([-2.6, 0.6, -2.4, 0.23, -1.5708, 0.0])
 #: home keeps the hand (TCP) within 0.34 m of the scooter's side and 0.15 m of its front; the
 #: straight moves on to the ready poses turn the elbow over in front, the hand up to 1.22 m
 #: high and 0.66 m ahead. All three are clear of the scooter. The move to ready straight from
-#: home turned it over out to the side instead, the hand 0.57 m out and 0.68 m ahead, into
-#: furniture the cameras had not seen (rad).
+#: home would turn it over out to the side instead, the hand 0.57 m out and 0.68 m ahead,
+#: where the cameras do not see (rad).
 UR5_UNSTOW_Q = np.array([-1.773, -0.338, -1.967, 0.734, -1.571, -0.203])
 #: Holding an object while the user drives and marks where it goes (pick and place): folded
 #: back along the scooter's right side, gripper down, the TCP at about (0.90, -0.65, 0.95) in
@@ -87,8 +87,13 @@ GRIPPER_FINGER_LENGTH = 0.05  #: finger root to fingertip (m)
 GRIPPER_PAD_DEPTH = 0.022  #: pad extent along the approach axis (m)
 GRIPPER_PAD_WIDTH = 0.022  #: pad extent along the hand axis (m)
 GRIPPER_PAD_THICKNESS = 0.008  #: pad thickness along the closing axis (m)
+GRIPPER_FINGER_THICKNESS = 0.008  #: finger plate along the closing axis, outside the pad (m)
+GRIPPER_FINGER_WIDTH = 0.024  #: finger plate extent along the hand axis (m)
 GRIPPER_BODY_WIDTH = 0.09  #: palm housing across the closing axis (m)
 GRIPPER_BODY_DEPTH = 0.06  #: palm housing along the hand axis (m)
+#: Palm housing along the approach axis, behind the finger roots (m): the gripper body less
+#: its 1 cm coupling to the flange.
+GRIPPER_PALM_LENGTH = 0.09
 #: Flange to TCP (m): the TCP sits midway between the pad centres.
 GRIPPER_TCP_OFFSET = GRIPPER_BASE_LENGTH + GRIPPER_FINGER_LENGTH - GRIPPER_PAD_DEPTH / 2
 GRIPPER_MASS = 0.9  #: kg, the 2F-85 datasheet
@@ -97,6 +102,46 @@ PAD_FRICTION = (1.5, 0.02, 0.001)  #: sliding, torsional, rolling: rubber pads
 GRIPPER_EMPTY_GAP = 0.003
 #: Summed pad contact normal force (N) above which the gripper counts as holding.
 GRIPPER_HOLD_FORCE = 2.0
+
+
+@dataclass(frozen=True)
+class HandGeometry:
+    """The open gripper as boxes, for grasp detection and the grasp tests (m), in a hand
+    frame: x the hand axis, y the closing axis (between the fingers), z the approach.
+
+    Two fingers, each a box from the inner pad face (at +-width_max / 2 from the hand centre
+    when open) outward by pad_thickness + finger_thickness, finger_length deep along the
+    approach and finger_width along the hand axis, with a pad pad_depth x pad_width at its
+    tip; behind the finger roots a palm box palm_width (closing) x palm_depth (hand axis) x
+    palm_length (approach). The TCP lies midway between the pads' centres, pad_depth / 2
+    behind the fingertips.
+    """
+
+    width_max: float  #: the stroke: the opening between the pads (m)
+    finger_length: float  #: finger root to fingertip (m)
+    pad_depth: float  #: pad extent along the approach axis (m)
+    pad_width: float  #: pad extent along the hand axis (m)
+    pad_thickness: float  #: pad thickness along the closing axis (m)
+    finger_thickness: float  #: finger plate along the closing axis, outside the pad (m)
+    finger_width: float  #: finger plate extent along the hand axis (m)
+    palm_width: float  #: palm across the closing axis (m)
+    palm_depth: float  #: palm along the hand axis (m)
+    palm_length: float  #: palm along the approach axis, behind the finger roots (m)
+
+
+#: The gripper above, as boxes.
+GRIPPER_HAND = HandGeometry(
+    width_max=GRIPPER_STROKE,
+    finger_length=GRIPPER_FINGER_LENGTH,
+    pad_depth=GRIPPER_PAD_DEPTH,
+    pad_width=GRIPPER_PAD_WIDTH,
+    pad_thickness=GRIPPER_PAD_THICKNESS,
+    finger_thickness=GRIPPER_FINGER_THICKNESS,
+    finger_width=GRIPPER_FINGER_WIDTH,
+    palm_width=GRIPPER_BODY_WIDTH,
+    palm_depth=GRIPPER_BODY_DEPTH,
+    palm_length=GRIPPER_PALM_LENGTH,
+)
 
 # --- Scooter (Merits Pioneer 10-like) ---------------------------------------------------------
 
@@ -121,8 +166,8 @@ BASKET_CENTER = np.array([0.99, 0.13, 0.80])
 BASKET_INNER = np.array([0.20, 0.32, 0.16])
 BASKET_WALL = 0.008
 #: m. The basket's floor is thicker than its walls: a thin, light object let go above it
-#: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and a floor as thin as the
-#: walls let it pass its middle in one step and fall through. Its top is at the walls' foot.
+#: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and through a floor as thin
+#: as the walls in one step. Its top is at the walls' foot.
 BASKET_FLOOR_THICKNESS = 0.03
 SCOOTER_MASS = 110.0
 

@@ -26,7 +26,8 @@ from typing import Literal
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.collision import (
+from laserpick.description.kinematics import T_BASE_UR5
+from laserpick.description.shapes import (
     HOUSING_CAPSULES,
     HOUSINGS,
     LINK_CAPSULES,
@@ -37,7 +38,6 @@ from laserpick.description.collision import (
     PROJECTOR_HOUSING_RAISE,
     body_frames,
 )
-from laserpick.description.kinematics import T_BASE_UR5
 from laserpick.transforms import make_transform, rotx
 
 __all__ = [

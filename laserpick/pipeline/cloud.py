@@ -167,6 +167,13 @@ def voxel_first(points: np.ndarray, size: float) -> np.ndarray:
     return np.sort(first)
 
 
+def thin(points: np.ndarray, voxel: float) -> np.ndarray:
+    """Mask of one point (the first) per occupied voxel of edge `voxel` (m)."""
+    keep = np.zeros(len(points), bool)
+    keep[voxel_first(points, voxel)] = True
+    return keep
+
+
 def voxel_downsample(cloud: FusedCloud, size: float) -> FusedCloud:
     """Keep the first point (in cloud order) of each occupied voxel of edge `size` (m)."""
     return cloud.subset(voxel_first(cloud.points, size))

@@ -2,8 +2,8 @@
 
 A fused cloud holds the surfaces the cameras saw, not the space behind them. An object seen
 from the front shows its front; a grasp detector that tests the hand against those points
-only may put a finger down into the object's unseen back (a cereal box standing on a shelf,
-its back guessed too thin, stopped the hand on its way in). The cameras say more than the
+only may put a finger down into the object's unseen back, where a guessed back is too thin.
+The cameras say more than the
 points: along each pixel's ray, space is free up to the depth it read. A point is seen free
 when some camera's reading at its pixel lies beyond it.
 
@@ -16,6 +16,7 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
+from laserpick.description.dims import GRIPPER_HAND
 from laserpick.settings import GraspSettings
 from laserpick.transforms import pinhole_project
 from laserpick.types import DepthFrame, Grasp
@@ -91,9 +92,8 @@ def beyond_view(
 
     target (N, 3), `base`: what the cameras saw of the object in `frames`. A point lies at
     the view's edge when it projects within VIEW_EDGE_PX of the border of some frame's
-    image and well inside none. The object may go on beyond: a lying juice bottle on the
-    108 cm table was seen 7.5 cm of its 20.6, and its unseen end, which no plan knew of, met
-    that table as the arm tucked it in (164 N).
+    image and well inside none. The object may go on beyond, and its unseen end, which no
+    plan knows of, can meet the furniture as the arm tucks it in.
 
     So the edge points are carried on, `step` (m) at a time, away from the seen part's
     middle, until the object spans OBJECT_SPAN_MAX that way. The way is level: what stands
@@ -134,15 +134,16 @@ def beyond_view(
     return copies[~seen_free(copies, [*frames, *others], tolerance)]
 
 
-def finger_probes(poses: np.ndarray, s: GraspSettings) -> np.ndarray:
+def finger_probes(poses: np.ndarray) -> np.ndarray:
     """(G, P, 3) points (m, `base`) inside the open fingers of the hands at TCP `poses`
     (G, 4, 4): PROBE_ACROSS x PROBE_DOWN in each finger's middle, both fingers."""
     poses = np.asarray(poses, np.float64).reshape(-1, 4, 4)
-    c = s.width_max / 2 + (s.pad_thickness + s.finger_thickness) / 2
-    tip = s.pad_depth / 2  # the TCP lies this far behind the fingertips
+    hand = GRIPPER_HAND
+    c = hand.width_max / 2 + (hand.pad_thickness + hand.finger_thickness) / 2
+    tip = hand.pad_depth / 2  # the TCP lies this far behind the fingertips
     local = np.array(
         [
-            (x * s.finger_width / 2, side * c, tip - d * s.finger_length)
+            (x * hand.finger_width / 2, side * c, tip - d * hand.finger_length)
             for side in (-1.0, 1.0)
             for x in PROBE_ACROSS
             for d in PROBE_DOWN
@@ -158,6 +159,6 @@ def fingers_seen_free(
     grasp's finger probes. True for all when there are no frames to ask."""
     if not frames or not grasps:
         return np.ones(len(grasps), bool)
-    probes = finger_probes(np.array([g.pose for g in grasps]), s)
+    probes = finger_probes(np.array([g.pose for g in grasps]))
     free = seen_free(probes.reshape(-1, 3), frames, s.free_space_tolerance)
     return free.reshape(len(grasps), -1).mean(axis=1) >= s.free_space_share

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from laserpick.settings import GraspSettings, get_settings
+from laserpick.description.dims import GRIPPER_HAND
 from laserpick.types import Failure, Grasp
 
 GRID_CELL = 0.01  #: m, EL-E's 2D occupancy grid resolution (000 section 4.4.1)
@@ -58,20 +58,18 @@ def overhead_grasp(
     scene: np.ndarray,
     surface_height: float,
     arm_xy: np.ndarray,
-    settings: GraspSettings | None = None,
 ) -> Grasp | Failure:
     """A top-down grasp of `target` (M, 3), checked against the `scene` cloud (N, 3).
 
     surface_height: z (m) of the support surface. arm_xy: the arm's base in `base` (m), for
     "the point nearest the robot". The scene cloud may include the target's own points.
     """
-    s = settings or get_settings().grasp
     if len(target) < 3:
         return Failure("detect_grasp", "I see too little of the object for an overhead grasp.")
     centroid, _, minor = occupancy_pca(target)
     top = float(target[:, 2].max())
     across = _extent(target[:, :2], minor)
-    if across <= s.width_max - 2 * GRID_CELL:
+    if across <= GRIPPER_HAND.width_max - 2 * GRID_CELL:
         closing = minor
         xy = centroid
         width = across
@@ -82,29 +80,29 @@ def overhead_grasp(
         closing = xy - centroid
         if np.linalg.norm(closing) < 1e-6:
             closing = minor
-        width = min(s.width_max, _extent(target[:, :2], closing / np.linalg.norm(closing)))
+        width = min(
+            GRIPPER_HAND.width_max, _extent(target[:, :2], closing / np.linalg.norm(closing))
+        )
     # The TCP is pad_depth / 2 above the fingertips, which stop FLOOR_GAP above the support.
-    z = max(surface_height + FLOOR_GAP + s.pad_depth / 2, top - GRASP_DEPTH)
+    z = max(surface_height + FLOOR_GAP + GRIPPER_HAND.pad_depth / 2, top - GRASP_DEPTH)
     pose = _pose(np.array([xy[0], xy[1], z]), closing)
     # The support itself is below the fingertips: its points (and their noise) do not block.
     above = scene[scene[:, 2] > surface_height + SUPPORT_BAND]
-    blocked = sweep_collisions(pose, above, target, s)
+    blocked = sweep_collisions(pose, above, target)
     if blocked:
         return Failure(
             "detect_grasp", f"An overhead grasp would hit {blocked} points on the way down."
         )
-    return Grasp(pose=pose, width=min(width, s.width_max))
+    return Grasp(pose=pose, width=min(width, GRIPPER_HAND.width_max))
 
 
-def sweep_collisions(
-    pose: np.ndarray, scene: np.ndarray, target: np.ndarray, s: GraspSettings
-) -> int:
+def sweep_collisions(pose: np.ndarray, scene: np.ndarray, target: np.ndarray) -> int:
     """How many non-target scene points lie in the volume the fingers sweep coming straight
     down onto `pose` (000 section 4.4.3): two finger slabs just outside the opening, from
     the grasp height up to 0.3 m above it."""
     R, p = pose[:3, :3], pose[:3, 3]
     local = (scene - p) @ R  # hand axis, closing axis, approach (down) components
-    half_open = s.width_max / 2
+    half_open = GRIPPER_HAND.width_max / 2
     finger = 0.012  #: m, finger thickness across the closing axis plus margin
     in_slab = (np.abs(local[:, 1]) > half_open - 0.002) & (np.abs(local[:, 1]) < half_open + finger)
     in_band = np.abs(local[:, 0]) < 0.015  # the pads' width along the hand axis, with margin

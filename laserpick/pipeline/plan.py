@@ -20,8 +20,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from laserpick.description import dims
-from laserpick.description.collision import GRIPPER_CAPSULES
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.description.shapes import GRIPPER_CAPSULES
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.timing import time_parametrize
@@ -213,12 +213,11 @@ class Searches:
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
-        camera saw: the cameras' view, not what they saw, kept the arm from it (above the
-        108 cm table, over their heads, their rays end on nothing in range). A short search
+        camera saw: the cameras' view, not what they saw, kept the arm from it (over their
+        heads, above a high table, their rays end on nothing in range). A short search
         (UNSEEN_SAMPLES) with its own generator, so the pick's own searches stay as they
         were; it only explains a failure, and such a way is never taken: an object seen in
-        part reaches into that space (a juice bottle lying across the view's edge, seen 8
-        of its 20 cm)."""
+        part may reach into that space."""
         rng = np.random.default_rng(0)
         quick = s.model_copy(update={"rrt_max_samples": UNSEEN_SAMPLES})
         return any(
@@ -280,9 +279,8 @@ def straight_lift(
     too: joint waypoints, or None if none is clear of the surroundings for the arm.
 
     payload: the object as it will be held (points, m, TCP frame), which must keep clear of
-    the arm's upper links all the way (`held_clear_of_arm`). Lifted from far out over the
-    87 cm counter, the arm straightens and its forearm comes down over the hand: a bowl held
-    by its far rim ended the full lift under it, and no way onward could start there."""
+    the arm's upper links all the way (`held_clear_of_arm`): lifting from far out, the arm
+    straightens and its forearm comes down over the hand, and what it holds."""
     for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
         lift = cartesian_line(q_from, lifted_pose(T_grasp, height), s.cartesian_step)
         if lift is None or not surroundings.clearance_ok(lift, hand=False).all():
@@ -307,6 +305,46 @@ def between_the_fingers(points: np.ndarray, T_grasp: np.ndarray) -> np.ndarray:
         & (local[:, 2] >= root)
         & (local[:, 2] <= tip)
     )
+
+
+def hand_fits(q_grasp: np.ndarray, T_grasp: np.ndarray, surroundings: CollisionChecker) -> bool:
+    """Whether the hand at its grasp (joint angles q_grasp (6,) rad, TCP pose T_grasp in
+    `base`) keeps out of the `surroundings`, but for HAND_CONTACT_TOLERANCE and what stands
+    between the open fingers: that is what they close on, parts of the object the
+    segmentation left out (a tissue packet's side face). The housing's spheres reach down
+    between the fingers, where the real housing does not."""
+    beside = surroundings.without(between_the_fingers(surroundings.points, T_grasp))
+    return bool(beside.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0])
+
+
+def transit_path(
+    q_now: np.ndarray,
+    q_pre: np.ndarray,
+    world: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    searches: Searches,
+    via: Sequence[np.ndarray] = (),
+    unstow: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`:
+    through `unstow` first when the world shows it clear, then the first of `via` that it
+    shows clear, each leg searched once per pick (`searches`). The leg to the pre-grasp
+    keeps the hand to space the cameras saw through. None when a leg finds no way."""
+    transit = None
+    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
+    clear = [q for q in via if world.clearance_ok(q)[0]]
+    legs = [q_now, *first, *clear[:1], q_pre]
+    for k, (a, b) in enumerate(itertools.pairwise(legs)):
+        # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
+        # beside the scooter and turns the elbow over above the cameras' view: a fixed way
+        # of straight moves, not held to seen space. Only the leg to the grasp is.
+        seen = k == len(legs) - 2 or not first
+        leg = searches.path(a, b, world, rng, s, seen=seen)
+        if leg is None:
+            return None
+        transit = leg if transit is None else np.vstack([transit, leg[1:]])
+    return transit
 
 
 def plan_pick(
@@ -347,13 +385,8 @@ def plan_pick(
     s = settings or get_settings().motion
     searches = searches or Searches(s.rrt_max_failed)
     T_grasp = tcp_pose(q_grasp)
-    if check_hand:
-        # What stands between the open fingers is what they close on: parts of the object
-        # the segmentation left out (a tissue packet's side face). The housing's spheres
-        # reach down between the fingers, where the real housing does not.
-        beside = surroundings.without(between_the_fingers(surroundings.points, T_grasp))
-        if not beside.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0]:
-            return Failure("ik_plan", "The hand would hit something beside the object.")
+    if check_hand and not hand_fits(q_grasp, T_grasp, surroundings):
+        return Failure("ik_plan", "The hand would hit something beside the object.")
     pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
     if len(pre) == 0:
         return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
@@ -366,20 +399,7 @@ def plan_pick(
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
-    transit = None
-    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
-    clear = [q for q in via if world.clearance_ok(q)[0]]
-    legs = [q_now, *first, *clear[:1], q_pre]
-    for k, (a, b) in enumerate(itertools.pairwise(legs)):
-        # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
-        # beside the scooter and turns the elbow over above the cameras' view: a fixed way
-        # of straight moves, not held to seen space. Only the leg to the grasp is.
-        seen = k == len(legs) - 2 or not first
-        leg = searches.path(a, b, world, rng, s, seen=seen)
-        if leg is None:
-            transit = None
-            break
-        transit = leg if transit is None else np.vstack([transit, leg[1:]])
+    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow)
     if transit is None:
         return Failure("ik_plan", "No collision-free path to this grasp was found.")
     return PickPlan(

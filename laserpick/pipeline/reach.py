@@ -92,6 +92,20 @@ def _clear_options(
     return out
 
 
+def _ik_options(pose: np.ndarray, q_ref: np.ndarray) -> list[Option]:
+    """The IK options (joint solution, grasp pose) of TCP `pose`, with its fingers as they are
+    and swapped, nearest q_ref (6,) rad first."""
+    Q = ik_tcp(pose, q_ref)
+    # Swapping the fingers is a half turn of the last joint, whose axis is the approach.
+    Q_swap = Q.copy()
+    Q_swap[:, 5] = q_ref[5] + wrap(Q[:, 5] + np.pi - q_ref[5])
+    Q_swap = Q_swap[np.abs(Q_swap[:, 5]) <= UR5_Q_MAX[5]]
+    poses = [pose] * len(Q) + [flipped(pose)] * len(Q_swap)
+    Q_all = np.vstack([Q, Q_swap])
+    order = np.argsort(np.linalg.norm(Q_all - q_ref, axis=1), kind="stable")
+    return [(Q_all[k], poses[k]) for k in order]
+
+
 def reachable(
     grasps: Sequence[Grasp],
     checker: CollisionChecker,
@@ -107,20 +121,8 @@ def reachable(
     (`MotionSettings.lift_least`); the arm must be clear there too, or the grasp is one the
     hand could close on but never raise (under a shelf's board). 0 skips the check.
     """
-    # Per grasp, its IK options (solution, pose), nearest q_ref first.
-    options: list[list[Option]] = []
-    failure: dict[int, str] = {}
-    for i, g in enumerate(grasps):
-        Q = ik_tcp(g.pose, q_ref)
-        # Swapping the fingers is a half turn of the last joint, whose axis is the approach.
-        Q_swap = Q.copy()
-        Q_swap[:, 5] = q_ref[5] + wrap(Q[:, 5] + np.pi - q_ref[5])
-        Q_swap = Q_swap[np.abs(Q_swap[:, 5]) <= UR5_Q_MAX[5]]
-        poses = [g.pose] * len(Q) + [flipped(g.pose)] * len(Q_swap)
-        Q_all = np.vstack([Q, Q_swap])
-        order = np.argsort(np.linalg.norm(Q_all - q_ref, axis=1), kind="stable")
-        options.append([(Q_all[k], poses[k]) for k in order])
-        failure[i] = "the arm cannot reach this grasp"
+    options: list[list[Option]] = [_ik_options(g.pose, q_ref) for g in grasps]
+    failure = {i: "the arm cannot reach this grasp" for i in range(len(grasps))}
     # Rank by rank, so that most grasps cost one pre-grasp IK and one batched collision test.
     # The hand is not checked at the grasp (grasp detection did that). After the first rank,
     # the arm at every remaining option is checked in one batch, before any more pre-grasps
@@ -157,11 +159,9 @@ def reachable(
         for i, good in zip(todo, ok, strict=True):
             if good:
                 chosen[i] = options[i][rank]
-    out = []
-    for i, g in enumerate(grasps):
-        if i in chosen:
-            q, pose = chosen[i]
-            out.append(replace(g, pose=pose, ik=q, ik_failure=None))
-        else:
-            out.append(replace(g, ik=None, ik_failure=failure[i]))
-    return out
+    return [
+        replace(g, pose=chosen[i][1], ik=chosen[i][0], ik_failure=None)
+        if i in chosen
+        else replace(g, ik=None, ik_failure=failure[i])
+        for i, g in enumerate(grasps)
+    ]

@@ -231,8 +231,8 @@ class ViewMemory:
         if not points:
             return Recalled()
         pts = np.concatenate(points)
-        # Most of what the views saw lies out of the arm's reach (in one kitchen case 18.8k
-        # of 245k points were within it); those points cannot matter to a plan, and they
+        # Most of what the views saw lies out of the arm's reach (in the kitchen, over nine
+        # tenths of it); those points cannot matter to a plan, and they
         # would cost the hidden-now test and the thinning their time.
         pts = pts[within_reach(pts)]
         return Recalled(tuple(frames), pts[voxel_first(pts, VIEW_VOXEL)])

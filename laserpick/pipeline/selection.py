@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
+from laserpick.description.dims import GRIPPER_HAND
 from laserpick.settings import GraspSettings, get_settings
 from laserpick.types import Grasp, GraspScores
 
@@ -23,7 +24,7 @@ def width_factor(width: float, s: GraspSettings) -> float:
     """Cw, eq. 3: 1 unless the width is within W_d of the stroke's ends, falling to 0 there."""
     if s.width_margin == 0:
         return 1.0
-    gap = min(abs(width - s.width_min), abs(width - s.width_max))
+    gap = min(abs(width - s.width_min), abs(width - GRIPPER_HAND.width_max))
     return 1.0 - max(0.0, s.width_margin - gap) / s.width_margin
 
 
@@ -40,27 +41,26 @@ def approach_factor(approach: np.ndarray, axis: np.ndarray) -> float:
     return 1.0
 
 
-def hand_bottom(pose: np.ndarray, s: GraspSettings) -> np.ndarray:
+def hand_bottom(pose: np.ndarray) -> np.ndarray:
     """G_b of eqs. 6 and 7, "a fixed point relative to the grasp position": GPD's grasp
     bottom, the middle of the hand's base between the finger roots (m, the frame of `pose`).
     It lies finger_length behind the fingertips, which are pad_depth / 2 ahead of the TCP.
 
-    Taken at the TCP, Cs preferred the grasps whose pads just reach an object's top edge:
-    on a standing soda can, the five best of 94 had their TCP within 1 cm of its top, and
-    the can slid out of the first while it was carried. At the bottom, Cs prefers the hand
-    the object fills, as 004 means it to ("decreases the possibility that the object will
+    Taken at the TCP, Cs prefers the grasps whose pads just reach an object's top edge, from
+    which a can slides out while it is carried. At the bottom, Cs prefers the hand the object
+    fills, as 004 means it to ("decreases the possibility that the object will
     slide away")."""
-    back = s.finger_length - s.pad_depth / 2
+    back = GRIPPER_HAND.finger_length - GRIPPER_HAND.pad_depth / 2
     return pose[:3, 3] - back * pose[:3, 2]
 
 
-def sample_factor(g_b: np.ndarray, sample: np.ndarray, s: GraspSettings) -> float:
+def sample_factor(g_b: np.ndarray, sample: np.ndarray) -> float:
     """Cs, eq. 6: 1 where the hand's bottom `g_b` (m, `hand_bottom`) is at the segmented
     cloud `sample`, 0 a finger length or more away from it."""
     if len(sample) == 0:
         return 0.0
     d = float(np.min(np.linalg.norm(sample - g_b, axis=1)))
-    return 1.0 - min(s.finger_length, d) / s.finger_length
+    return 1.0 - min(GRIPPER_HAND.finger_length, d) / GRIPPER_HAND.finger_length
 
 
 def mark_factor(g_b: np.ndarray, mark: np.ndarray, s: GraspSettings) -> float:
@@ -81,12 +81,12 @@ def score(
     s = settings or get_settings().grasp
     if grasp.ik is None:
         raise ValueError("score() needs a grasp with an IK solution (Cj is a joint distance)")
-    g_b = hand_bottom(grasp.pose, s)
+    g_b = hand_bottom(grasp.pose)
     scores = GraspScores(
         Cw=width_factor(grasp.width, s),
         Cj=joint_factor(q_now, grasp.ik, s),
         Ca=approach_factor(grasp.approach, grasp.axis),
-        Cs=sample_factor(g_b, sample, s),
+        Cs=sample_factor(g_b, sample),
         Cp=mark_factor(g_b, mark, s),
     )
     return replace(grasp, scores=scores)
@@ -127,7 +127,7 @@ def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> Gra
 
     Ours: 004 orders by score alone. But C does not see where along the pads the object
     lies, and a can met only toward the pads' edges spins out of the hand when the scooter
-    turns (seed 1's soda can, stop 57). Such a grasp is still offered, after the others:
+    turns. Such a grasp is still offered, after the others:
     it is often the only one an object has."""
     s = settings or get_settings().grasp
     if not grasps:

@@ -192,9 +192,9 @@ def place_target(
     The mark must be on a flat surface (`is_flat_surface`). If it lies less than
     `place_edge_margin` (10 cm) behind the surface's front edge, the edge nearest the robot,
     it moves straight back (+x) until it is 10 cm behind that edge. Not on the floor
-    (`on_floor`): nothing falls from it, and its nearest seen boundary
-    is only where the cameras' view begins (a cereal box marked 5 cm past it was set down
-    5 cm from its mark). Returns the (3,) point on the surface at height z_top, or a Failure.
+    (`on_floor`): nothing falls from it, and its nearest seen boundary is only where the
+    cameras' view begins, not an edge to keep clear of. Returns the (3,) point on the
+    surface at height z_top, or a Failure.
     """
     mark = np.asarray(mark_point, np.float64)
     pts = cloud.points
@@ -225,8 +225,8 @@ def still_standing(points: np.ndarray, standing: np.ndarray, surface_z: float) -
     surface; False when the cameras see the surface bare there, SEEN_POINTS or more of it
     and fewer than STRAY_POINTS above it (the object is gone: it fell off the spot, or the
     hand took it along); None otherwise, nothing known. Something lower than expected but
-    still there is None, not False: a banana that had turned 40 degrees in the pads was let
-    go tilted, settled flat within 3 cm of its mark, and read as fallen.
+    still there is None, not False: an object let go tilted settles flat on its mark, lower
+    than it was held.
     """
     height = float(standing[:, 2].max()) - surface_z
     if len(points) == 0 or height <= SURFACE_BAND:

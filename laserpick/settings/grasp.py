@@ -8,16 +8,13 @@ __all__ = ["GraspSettings"]
 
 
 class GraspSettings(BaseModel):
-    """Grasp selection parameters (paper 004 section 7) and the hand geometry the pipeline uses.
+    """Grasp detection (GPD) and selection parameters (paper 004 sections 6.2 and 7).
 
-    The hand geometry mirrors the gripper in `laserpick.description.dims` (a test holds them equal);
-    it is repeated here because pipeline/ may not import robot/.
+    The hand's geometry is not a setting: it is the gripper's, `description.dims.GRIPPER_HAND`.
     """
 
-    width_min: float = Field(0.0, ge=0, description="Gripper's smallest opening W_min (m).")
-    width_max: float = Field(0.085, gt=0, description="Gripper's stroke W_max (m). 2F-85.")
-    finger_length: float = Field(
-        0.05, gt=0, description="Finger length l, the reach of Cs (m). Eq. 6 of 004."
+    width_min: float = Field(
+        0.0, ge=0, description="W_min of 004 eq. 3, the smallest opening (m); W_max is the stroke."
     )
     width_margin: float = Field(
         0.015, ge=0, description="W_d, the distance kept from the stroke's ends (m). 004 eq. 3."
@@ -38,39 +35,6 @@ class GraspSettings(BaseModel):
         gt=0,
         description="Largest distance between two grasps of one cluster (m). 004 section 7.2.",
     )
-    # Hand geometry for grasp detection (collision boxes); description/dims.py and robot/model.py.
-    pad_depth: float = Field(
-        0.022, gt=0, description="Pad extent along the approach axis (m). description/dims.py."
-    )
-    pad_width: float = Field(
-        0.022, gt=0, description="Pad extent along the hand axis (m). description/dims.py."
-    )
-    pad_thickness: float = Field(
-        0.008, gt=0, description="Pad thickness along the closing axis (m). description/dims.py."
-    )
-    finger_thickness: float = Field(
-        0.008,
-        gt=0,
-        description="Finger plate thickness along the closing axis, outside the pad (m). "
-        "robot/model.py.",
-    )
-    finger_width: float = Field(
-        0.024,
-        gt=0,
-        description="Finger plate extent along the hand axis (m). robot/model.py.",
-    )
-    palm_width: float = Field(
-        0.09, gt=0, description="Palm housing across the closing axis (m). description/dims.py."
-    )
-    palm_depth: float = Field(
-        0.06, gt=0, description="Palm housing along the hand axis (m). description/dims.py."
-    )
-    palm_length: float = Field(
-        0.09,
-        gt=0,
-        description="Palm housing along the approach axis, behind the finger roots (m). "
-        "robot/model.py (GRIPPER_BASE_LENGTH less the 1 cm coupling).",
-    )
     side_clearance: float = Field(
         0.004,
         ge=0,
@@ -79,8 +43,8 @@ class GraspSettings(BaseModel):
         " sides and the palm's sides: GPD's detector tests a hand this much larger on each"
         " side, whose opening is this much narrower on each side; a vertical grasp needs the"
         " object this much narrower than the opening on each side. A depth camera sees a box's"
-        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm;"
-        " with no gap a finger slid down an edge it had missed by 0.4 mm. Ours.",
+        " edge up to a few mm short of where it is, and the arm tracks its path to a few mm."
+        " Ours.",
     )
     free_space_tolerance: float = Field(
         0.006,
@@ -151,14 +115,14 @@ class GraspSettings(BaseModel):
         lt=90,
         description="A pad meets the object along its face where the object's normals at the"
         " pad's extreme lie within this angle (deg) of the closing axis"
-        " (grasp_detect.closing_region). Ours.",
+        " (gpd.antipodal.closing_region). Ours.",
     )
     gpd_patch_offset: float = Field(
         0.007,
         ge=0,
         description="How far (m) along the hand axis the middle of the patch where a pad meets"
         " the object may lie from the pad's middle for the grasp to count as centred"
-        " (grasp_detect.closing_region), and be offered before those that do not"
+        " (gpd.antipodal.closing_region), and be offered before those that do not"
         " (selection.group): a pad that meets it only at its edge lets it spin out. Ours.",
     )
     gpd_recentre: float = Field(
@@ -167,7 +131,7 @@ class GraspSettings(BaseModel):
         description="How far (m) past each side of the pads a hand that is not centred"
         " (gpd_patch_offset) looks for where its pads would meet the object along their face;"
         " it is tried again turned about its axis and moved along it onto that patch"
-        " (grasp_detect.patch_moves). 0 turns this off. Ours: one pad width.",
+        " (gpd.recentre.patch_moves). 0 turns this off. Ours: one pad width.",
     )
     gpd_collision_voxel: float = Field(
         0.0,

@@ -7,7 +7,7 @@ import numpy as np
 
 from laserpick.bench.attempts import Attempt
 from laserpick.bench.picking import ScriptedOperator
-from laserpick.pipeline.grasping import UNSEEN_WAYS
+from laserpick.pipeline.grasp_choice import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import Scene
 
 #: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until

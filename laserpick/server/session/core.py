@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from laserpick.behaviours import Behaviours
-from laserpick.pipeline.grasping import GraspSet
+from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.robot.interface import Robot

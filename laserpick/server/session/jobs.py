@@ -13,8 +13,8 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasping import find_grasps
-from laserpick.pipeline.laser import detect_mark
+from laserpick.pipeline.grasp_choice import find_grasps
+from laserpick.pipeline.laser_spots import detect_mark
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.selection import GraspCursor

@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.collision import HOUSING_CAPSULES, LINK_CAPSULES
+from laserpick.description.shapes import HOUSING_CAPSULES, LINK_CAPSULES
 from laserpick.robot.sim.model.geoms import (
     ARM_AFFINITY,
     ARM_TYPE,

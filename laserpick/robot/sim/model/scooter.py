@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.collision import (
+from laserpick.description.shapes import (
     HOUSINGS,
     PEDESTAL_FOOT,
     PEDESTAL_RADIUS,

@@ -1,8 +1,8 @@
 """Collision geometry of the robot for planning: the UR5's link capsules, the gripper's, and
 keep-out boxes around the scooter and its rider.
 
-The same tables build the MuJoCo model (robot/model.py) and the planner's sphere model and
-keep-out boxes (pipeline/collision.py), so what the planner avoids is what the simulator
+The same tables build the MuJoCo model (robot/sim/model.py) and the planner's sphere model and
+keep-out boxes (pipeline/collision/), so what the planner avoids is what the simulator
 collides: the link capsules, the joint housings around each joint, and the boxes of the
 cameras and the projector on the scooter's posts.
 
@@ -47,8 +47,8 @@ def _link_capsules() -> tuple[tuple[Segment, ...], ...]:
 LINK_CAPSULES: tuple[tuple[Segment, ...], ...] = _link_capsules()
 #: The joint housings: a ball, or a short capsule along the joint's axis, around each link's
 #: joint at its body frame's origin (from, to, radius; m). A little wider than the link
-#: tubes, they reach past the tubes' ends: planned without them, the wrist struck the
-#: projector (155 N in an isolation run).
+#: tubes, they reach past the tubes' ends, where the wrist's housing would otherwise meet the
+#: projector unplanned.
 HOUSING_CAPSULES: tuple[Segment, ...] = tuple(
     ((0.0, 0.0, -reach), (0.0, 0.0, reach), r)
     for r, reach in (

@@ -1,0 +1,35 @@
+"""The candidates that passed GPD's tests, with the frames they came from. Metres, radians."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class HandCandidates:
+    """The passing candidates of some frames: (G,) each, or (G, 4, 4) poses relative to the
+    target's centre. sample, orientation: the frame's indices into `samples` and `angles`;
+    offset, tip: its hand centre on the closing axis and fingertip depth (m), as
+    closing_region has them."""
+
+    samples: np.ndarray
+    normal: np.ndarray
+    axis: np.ndarray
+    angles: np.ndarray
+    sample: np.ndarray
+    orientation: np.ndarray
+    offset: np.ndarray
+    tip: np.ndarray
+    width: np.ndarray
+    centred: np.ndarray
+    poses: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.sample)
+
+    def subset(self, keep: np.ndarray) -> HandCandidates:
+        """The candidates `keep` (indices) of these."""
+        per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
+        return replace(self, **{k: getattr(self, k)[keep] for k in per})
