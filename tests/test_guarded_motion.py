@@ -93,7 +93,7 @@ def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
     for _ in range(30):  # 3 s at 0.2 m/s
         robot.drive(0.2, 0.0, 0.2)
         robot.sleep(0.1)
-        pushed.append(sim.call(lambda m, d: sim._felt(sim._arm_contacts())))
+        pushed.append(sim.call(lambda m, d: sim.felt(sim.arm_contacts())))
     moved = robot.base_pose()[0] - x0
     assert moved > gap - 0.08 and max(pushed) > 50, "the hand reached the table"
     assert max(pushed) < 1.2 * dims.UR5_PROTECTIVE_STOP_FORCE, f"pushed {max(pushed):.0f} N"

@@ -44,12 +44,12 @@ def robot():
 
 def borne_from_below(robot: SimRobot, name: str) -> float:
     """The upward force (N) on object `name` from everything but the arm and the gripper:
-    what it rests on, and anything pressing it into that (`Simulation._contacts`)."""
+    what it rests on, and anything pressing it into that (`Simulation.contacts`)."""
     sim = robot.sim
     ours = sim.model.geom_bodyid == sim.info.object_bodies[name]
     arm = np.zeros(sim.model.ngeom, bool)
     arm[sim.info.arm_geoms] = True
-    contacts = sim.call(lambda m, d: sim._contacts(ours, from_outside=True))
+    contacts = sim.call(lambda m, d: sim.contacts(ours, from_outside=True))
     return float(sum(c.on_ours[2] for c in contacts if not arm[c.other]))
 
 

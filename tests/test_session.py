@@ -203,17 +203,17 @@ def test_a_second_click_on_the_dot_confirms_though_a_new_capture_sees_otherwise(
         def click(at_base: np.ndarray) -> None:
             direction = to_world(at_base, session.robot.base_pose()) - origin
             event = SimpleNamespace(ray_origin=origin, ray_direction=direction, client=None)
-            console._clicked(event)
+            console.on_click(event)
 
         click(centre)
         assert session.state == TaskState.AIMING
-        aimed = console._aimed_at
+        aimed = console.aimed_at
         assert aimed is not None and np.linalg.norm(aimed - centre) < 0.03
         click(aimed + np.array([0.0, 0.2, 0.0]))  # elsewhere: a new aim, not a confirm
         assert session.state == TaskState.AIMING and not session.busy
-        assert np.linalg.norm(console._aimed_at - aimed) > 0.1
+        assert np.linalg.norm(console.aimed_at - aimed) > 0.1
         click(centre)
-        aimed = console._aimed_at
+        aimed = console.aimed_at
         truth.take_out(name)
         session.expire_capture()
         states: list[str] = []
@@ -224,7 +224,7 @@ def test_a_second_click_on_the_dot_confirms_though_a_new_capture_sees_otherwise(
         # Confirmed, the session marks at once; its job then finds no object there (taken
         # away) and may already be back to aiming, so the marking is what is looked for.
         assert TaskState.MARKED.value in states
-        assert console._aimed_at is None
+        assert console.aimed_at is None
     finally:
         console.stop()
         session.close()

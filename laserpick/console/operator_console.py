@@ -80,7 +80,7 @@ class OperatorConsole:
             server, session, self.act, controls=controls, on_show_cloud=self.cloud.set_visible
         )
         if controls:
-            server.scene.on_click()(self._clicked)
+            server.scene.on_click()(self.on_click)
         session.on_event(self._on_event)
 
     # --- lifecycle -------------------------------------------------------------------------
@@ -139,7 +139,7 @@ class OperatorConsole:
                 client.add_notification("Not now", str(exc), color="yellow", auto_close_seconds=4.0)
             return False
 
-    def _clicked(self, event: viser.SceneClickEvent) -> None:
+    def on_click(self, event: viser.SceneClickEvent) -> None:
         """Aim where the click's ray meets the cloud; a second click on the aimed point (its
         ray passes within CONFIRM_RADIUS of it) confirms the mark there (or the place mark),
         as the laser points: the session has worked that mark out since the first click.
@@ -166,6 +166,11 @@ class OperatorConsole:
             event.client, lambda a: hit.append(session.ray_point(origin, direction, "world"))
         ) and self.act(event.client, lambda a: session.aim_at(a, hit[0], "base", foresee=True)):
             self._aimed_at = hit[0]
+
+    @property
+    def aimed_at(self) -> np.ndarray | None:
+        """Where the last click aimed the laser (m, `base`), until a click confirms it."""
+        return self._aimed_at
 
     # --- drawing ---------------------------------------------------------------------------
 

@@ -424,11 +424,6 @@ class Simulation:
         """What the UR5's force estimate reads of `contacts` (N; `contacts.felt_force`)."""
         return felt_force(self.model, contacts)
 
-    # The same, by the private names tests/test_behaviours.py calls.
-    _contacts = contacts
-    _arm_contacts = arm_contacts
-    _felt = felt
-
     def _gripper_force(self) -> float:
         """Force (N) on the pads: what the gripper's own current sensing reports."""
         return sum(c.normal for c in self.contacts(self._pad_geoms))
