@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from laserpick.description import dims
-from laserpick.description.visuals import PARTS, part_poses
-from laserpick.robot.sim.model import ARM_JOINTS, FINGER_JOINTS, build_sim_model
+from laserpick.description.visuals import PARTS, finger, part_poses
+from laserpick.robot.sim.model import ARM_JOINTS, FINGER_JOINTS, build_arm_model, build_sim_model
 from laserpick.transforms import invert, make_transform, matrix_from_quat
 
 KIND = {
@@ -76,3 +76,16 @@ def test_part_poses_are_the_simulator_s_body_poses(model) -> None:
         for part, T in zip(PARTS, part_poses(q, width), strict=True):
             in_base = invert(T_world_base) @ pose(model.body(part.name).id)
             np.testing.assert_allclose(in_base, T, atol=1e-9, err_msg=part.name)
+
+
+def test_the_arm_model_holds_the_described_fingers_fully_open() -> None:
+    model = build_arm_model()
+    for side in ("left", "right"):
+        part = finger(side, travel=dims.GRIPPER_STROKE / 2)
+        for shape in part.shapes:
+            g = model.geom(shape.name).id
+            assert model.geom_bodyid[g] == model.body(part.name).id, shape.name
+            np.testing.assert_array_equal(model.geom_pos[g], shape.pose[:3, 3])
+            np.testing.assert_array_equal(model.geom_size[g], shape.size)
+    gap = model.geom("gripper/pad_left").pos[1] - model.geom("gripper/pad_right").pos[1]
+    assert gap - dims.GRIPPER_PAD_THICKNESS == pytest.approx(dims.GRIPPER_STROKE)

@@ -7,12 +7,12 @@ part has a frame; its shapes are posed in it. `part_poses(q, width)` is the forw
 kinematics of the parts: every part's frame in `base` for joint angles q and a gripper
 opening. A 3D view draws the robot from these alone, for any robot that reports its joints.
 
-The simulator's model has geoms of the same names, sizes, poses and colours (a test holds
-them together), and the link shapes are the planner's collision capsules
-(`collision.LINK_CAPSULES`, `collision.HOUSING_CAPSULES`).
+The simulator builds its robot's geoms from these parts (it adds only what simulation needs:
+masses, contact bits, friction), and the link shapes are the planner's collision capsules
+(`shapes.LINK_CAPSULES`, `shapes.HOUSING_CAPSULES`).
 
 Frames: the scooter's shapes are in `base`; the arm mount's in the UR5 base frame; link i's
-in its body frame (`collision.body_frames`); the gripper's in the flange frame (z approach,
+in its body frame (`shapes.body_frames`); the gripper's in the flange frame (z approach,
 y closing); each finger's in a frame shifted from the flange along y by half the opening.
 Metres and radians throughout; colours are RGBA in [0, 1].
 """
@@ -44,13 +44,13 @@ __all__ = [
     "ARM_RGBA",
     "BASKET_RGBA",
     "DARK_RGBA",
-    "FINGER_PLATE_THICKNESS",
     "JOINT_RGBA",
     "PAD_RGBA",
     "PARTS",
     "SCOOTER_RGBA",
     "Part",
     "Shape",
+    "finger",
     "part_poses",
 ]
 
@@ -60,8 +60,6 @@ SCOOTER_RGBA = (0.75, 0.12, 0.12, 1.0)  #: the scooter's deck and tiller
 DARK_RGBA = (0.12, 0.12, 0.13, 1.0)  #: seat, wheels, posts, housings, the gripper's body
 PAD_RGBA = (0.05, 0.05, 0.05, 1.0)  #: the gripper's rubber pads
 BASKET_RGBA = (0.15, 0.15, 0.16, 1.0)
-#: Thickness of a finger's plate along the closing axis (m); its pad sits on its inner face.
-FINGER_PLATE_THICKNESS = 0.008
 
 Kind = Literal["box", "sphere", "capsule", "cylinder"]
 RGBA = tuple[float, float, float, float]
@@ -71,13 +69,16 @@ RGBA = tuple[float, float, float, float]
 class Shape:
     """One solid of a part. `size`: a box's half extents; a sphere's (radius,); a capsule's
     or a cylinder's (radius, half length) along its own z axis (a capsule's length without
-    its caps). `pose`: 4x4, the solid's frame in its part's frame (m)."""
+    its caps). `pose`: 4x4, the solid's frame in its part's frame (m). `fromto`: a capsule
+    given by its axis' end points, (ax, ay, az, bx, by, bz) in the part's frame (m), from
+    which its pose and half length follow; None for every other solid."""
 
     name: str
     kind: Kind
     size: tuple[float, ...]
     pose: np.ndarray
     rgba: RGBA
+    fromto: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -109,7 +110,8 @@ def _capsule(name: str, a, b, radius: float, rgba: RGBA) -> Shape:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     length = float(np.linalg.norm(b - a))
     R = _z_to((b - a) / length)
-    return Shape(name, "capsule", (radius, length / 2), _at((a + b) / 2, R), rgba)
+    ends = tuple(float(v) for v in (*a, *b))
+    return Shape(name, "capsule", (radius, length / 2), _at((a + b) / 2, R), rgba, ends)
 
 
 def _box(name: str, half, pos, rgba: RGBA, R: np.ndarray | None = None) -> Shape:
@@ -223,12 +225,8 @@ def _scooter() -> tuple[Shape, ...]:
         _at((mx, my, (mz + PEDESTAL_FOOT) / 2)),
         DARK_RGBA,
     )
-    bracket = _box(
-        "scooter/arm_bracket",
-        ((mx - 0.9) / 2 + 0.05, 0.05, 0.04),
-        ((mx + 0.9) / 2, my, 0.19),
-        DARK_RGBA,
-    )
+    bracket_half, bracket_at = ((mx - 0.9) / 2 + 0.05, 0.05, 0.04), ((mx + 0.9) / 2, my, 0.19)
+    bracket = _box("scooter/arm_bracket", bracket_half, bracket_at, DARK_RGBA)
     parts = [deck, *_seat_and_tiller(), *_wheels(), *_posts_and_housings(), *_basket()]
     return (*parts, pedestal, bracket)
 
@@ -261,25 +259,21 @@ def _gripper() -> tuple[Shape, ...]:
     )
 
 
-def _finger(side: str, sign: float) -> tuple[Shape, ...]:
-    """A finger's plate and pad in its frame, where the pad's face lies on the hand's centre."""
+def finger(side: Literal["left", "right"], travel: float = 0.0) -> Part:
+    """The finger on `side` (left: +y): its plate and its pad, posed so that the pad's face
+    lies `travel` (m) out from its frame's origin along the closing axis. `PARTS` holds them
+    at travel 0, in the frame `part_poses` gives the finger (the flange frame moved out by half
+    the opening); in the flange frame itself, travel `dims.GRIPPER_STROKE` / 2 is the finger
+    fully open."""
+    sign = 1.0 if side == "left" else -1.0
     L, F = dims.GRIPPER_BASE_LENGTH, dims.GRIPPER_FINGER_LENGTH
-    plate_t, pad_t = FINGER_PLATE_THICKNESS, dims.GRIPPER_PAD_THICKNESS
+    plate_t, pad_t = dims.GRIPPER_FINGER_THICKNESS, dims.GRIPPER_PAD_THICKNESS
+    plate = (dims.GRIPPER_FINGER_WIDTH / 2, plate_t / 2, F / 2)
     pad = (dims.GRIPPER_PAD_WIDTH / 2, pad_t / 2, dims.GRIPPER_PAD_DEPTH / 2)
-    return (
-        _box(
-            f"gripper/finger_{side}",
-            (0.012, plate_t / 2, F / 2),
-            (0, sign * (pad_t + plate_t / 2), L + F / 2),
-            ARM_RGBA,
-        ),
-        _box(
-            f"gripper/pad_{side}",
-            pad,
-            (0, sign * pad_t / 2, L + F - dims.GRIPPER_PAD_DEPTH / 2),
-            PAD_RGBA,
-        ),
-    )
+    plate_at = (0, sign * (travel + pad_t + plate_t / 2), L + F / 2)
+    pad_at = (0, sign * (travel + pad_t / 2), L + F - dims.GRIPPER_PAD_DEPTH / 2)
+    plate_box = _box(f"gripper/finger_{side}", plate, plate_at, ARM_RGBA)
+    return Part(f"finger_{side}", (plate_box, _box(f"gripper/pad_{side}", pad, pad_at, PAD_RGBA)))
 
 
 #: The robot's parts in the order `part_poses` gives their frames.
@@ -291,8 +285,8 @@ PARTS: tuple[Part, ...] = (
     ),
     *(Part(f"ur5/link{i + 1}", _link(i)) for i in range(6)),
     Part("gripper", _gripper()),
-    Part("finger_left", _finger("left", 1.0)),
-    Part("finger_right", _finger("right", -1.0)),
+    finger("left"),
+    finger("right"),
 )
 
 

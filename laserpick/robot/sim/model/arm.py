@@ -1,4 +1,5 @@
-"""The UR5 in the model: six links on DH frames with their collision capsules and joint housings.
+"""The UR5 in the model: six links on DH frames, each with the described capsules and joint
+housing of its part (`description.visuals`).
 
 The UR5 bodies follow the standard DH convention exactly: body i is frame i-1 turned by q_i about
 its z axis, and body i+1 sits at (a_i, 0, d_i) turned by alpha_i about x. So MuJoCo's forward
@@ -11,52 +12,31 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.description.shapes import HOUSING_CAPSULES, LINK_CAPSULES
-from laserpick.robot.sim.model.geoms import (
-    ARM_AFFINITY,
-    ARM_TYPE,
-    DARK_RGBA,
-    JOINT_RGBA,
-    ROBOT_RGBA,
-    G,
-    J,
-    add_geom,
-    quat_list,
-)
+from laserpick.description.shapes import LINK_CAPSULES
+from laserpick.robot.sim.model.geoms import ARM_GEOM, PARTS_BY_NAME, J, add_shape, quat_list
 from laserpick.robot.sim.model.gripper import add_gripper
 from laserpick.robot.sim.model.names import ARM_PREFIX, FLANGE_SITE, arm_joint_name
-from laserpick.robot.sim.objects import GROUP_ROBOT
 from laserpick.transforms import rotx, rotz
 
 
-def capsule_between(
-    body: mujoco.MjsBody, name: str, a, b, radius: float, mass: float, rgba=ROBOT_RGBA
-) -> mujoco.MjsGeom:
-    """An arm collision capsule from point a to point b in the body's frame (m)."""
-    return add_geom(
-        body,
-        name,
-        G.mjGEOM_CAPSULE,
-        (radius,),
-        fromto=[*a, *b],
-        mass=mass,
-        rgba=list(rgba),
-        group=GROUP_ROBOT,
-        contype=ARM_TYPE,
-        conaffinity=ARM_AFFINITY,
-    )
+def _add_link_geoms(body: mujoco.MjsBody, i: int) -> None:
+    """Link i+1's capsules, sharing the link's mass, and its massless joint housing."""
+    share = dims.UR5_LINK_MASSES[i + 1] / len(LINK_CAPSULES[i])
+    for shape in PARTS_BY_NAME[body.name].shapes:
+        mass = 0.0 if shape.name == body.name + "/joint" else share
+        add_shape(body, shape, mass=mass, **ARM_GEOM)
 
 
 def add_ur5(parent: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
     """The UR5 and its gripper under `parent`; returns the gripper body."""
     d, a, alpha = dims.UR5_D, dims.UR5_A, dims.UR5_ALPHA
-    m, r = dims.UR5_LINK_MASSES, dims.UR5_LINK_RADII
     base = parent.add_body(
         name=ARM_PREFIX + "base",
         pos=dims.ARM_MOUNT_POS.tolist(),
         quat=quat_list(rotz(dims.ARM_MOUNT_YAW)),
     )
-    capsule_between(base, ARM_PREFIX + "base/c", (0, 0, 0.0), (0, 0, 0.03), r[0], m[0], DARK_RGBA)
+    for shape in PARTS_BY_NAME[base.name].shapes:
+        add_shape(base, shape, mass=dims.UR5_LINK_MASSES[0], **ARM_GEOM)
 
     body = base
     for i in range(6):
@@ -71,22 +51,7 @@ def add_ur5(parent: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         j.armature = 0.1 if i < 3 else 0.02
         j.damping = [1.0 if i < 3 else 0.2, 0.0, 0.0]
-        share = m[i + 1] / len(LINK_CAPSULES[i])
-        for k, (p0, p1, rad) in enumerate(LINK_CAPSULES[i]):
-            if np.allclose(p0, p1):
-                p1 = (p1[0], p1[1], p1[2] + 1e-3)
-            capsule_between(body, ARM_PREFIX + f"link{i + 1}/c{k}", p0, p1, rad, share)
-        # The joint's housing, for looks and collision: a ball or a short capsule.
-        _, end, radius = HOUSING_CAPSULES[i]  # centred on the origin, along z
-        hous = body.add_geom(name=ARM_PREFIX + f"link{i + 1}/joint", pos=[0, 0, 0])
-        if end[2] > 0:
-            hous.type, hous.size = G.mjGEOM_CAPSULE, [radius, end[2], 0]
-        else:
-            hous.type, hous.size = G.mjGEOM_SPHERE, [radius, 0, 0]
-        hous.rgba = list(JOINT_RGBA)
-        hous.group = GROUP_ROBOT
-        hous.mass = 0.0
-        hous.contype, hous.conaffinity = ARM_TYPE, ARM_AFFINITY
+        _add_link_geoms(body, i)
     flange = body.add_body(name=ARM_PREFIX + "flange", pos=[0, 0, d[5]])
     flange.add_site(name=FLANGE_SITE, pos=[0, 0, 0], size=[0.005, 0, 0], group=5)
     return add_gripper(flange, fingers_move)
