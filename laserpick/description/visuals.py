@@ -9,10 +9,10 @@ opening. A 3D view draws the robot from these alone, for any robot that reports 
 
 The simulator's model has geoms of the same names, sizes, poses and colours (a test holds
 them together), and the link shapes are the planner's collision capsules
-(`collision.LINK_CAPSULES`, `collision.HOUSING_CAPSULES`).
+(`shapes.LINK_CAPSULES`, `shapes.HOUSING_CAPSULES`).
 
 Frames: the scooter's shapes are in `base`; the arm mount's in the UR5 base frame; link i's
-in its body frame (`collision.body_frames`); the gripper's in the flange frame (z approach,
+in its body frame (`shapes.body_frames`); the gripper's in the flange frame (z approach,
 y closing); each finger's in a frame shifted from the flange along y by half the opening.
 Metres and radians throughout; colours are RGBA in [0, 1].
 """

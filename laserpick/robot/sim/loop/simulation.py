@@ -424,7 +424,7 @@ class Simulation:
         """What the UR5's force estimate reads of `contacts` (N; `contacts.felt_force`)."""
         return felt_force(self.model, contacts)
 
-    # The same, by the private names tests/test_behaviours.py calls.
+    # The same, by the private names tests/test_guarded_motion.py and tests/test_place.py call.
     _contacts = contacts
     _arm_contacts = arm_contacts
     _felt = felt
