@@ -185,7 +185,7 @@ class Grasp:
     cluster: index of the position cluster for manual selection (-1 before clustering).
     ik: the chosen joint solution (6,), or None with `ik_failure` saying why.
     pads_centred: whether each pad meets the object along its face, about its middle
-    (`grasp_detect.closing_region`): False for a GPD candidate whose pad meets it only
+    (`pipeline.gpd.antipodal.closing_region`): False for a GPD candidate whose pad meets it only
     toward an edge, offered after the others (`selection.group`).
     """
 

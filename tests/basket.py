@@ -1,9 +1,9 @@
 """Judging a pick-and-drop that the API or an adapter drove, from the simulator's truth.
 
 The session reports "Dropped in the basket" when it has opened the hand over the basket; it
-cannot see whether the object landed inside. Landing is issue 4's grasp success (the
-isolation benchmark: a few drops in 90 slip out while lifted or carried; the session then
-says the object "fell from the hand while it was carried").
+cannot see whether the object landed inside. Landing is the isolation benchmark's grasp
+success (004 section 8.1); a drop may slip out while lifted or carried, and the session then
+says the object "fell from the hand while it was carried".
 So these tests require the object to have left its place on the table; an object that did,
 but lies outside the basket, is that known physical failure and is reported as xfail with
 where it ended, not as a failure of the input path under test.
@@ -30,7 +30,7 @@ def lost_in_carry(reported: str | dict | None) -> bool:
 def judge_drop(result: dict, lost: bool = False, scene: str = "isolation") -> None:
     """`result`: the object's `GET /sim/objects` record after the drop. lost: the session
     reported that the object fell from the hand while carried, which, like a release beside
-    the basket, is issue 4's known failure once the object has left the table."""
+    the basket, is the drop's known physical failure once the object has left the table."""
     if result["in_basket"]:
         return
     start = next(p.pos for p in load_scene(scene).placements if p.instance == result["name"])
@@ -38,7 +38,7 @@ def judge_drop(result: dict, lost: bool = False, scene: str = "isolation") -> No
     if moved > 0.10:
         how = "fell from the hand while carried" if lost else "was released over the basket"
         pytest.xfail(
-            f"issue 4: {result['name']} was carried off and {how}, and lies outside the"
+            f"known drop failure: {result['name']} was carried off and {how}, and lies outside the"
             f" basket, at {result['position_world']}"
         )
     raise AssertionError(f"{result['name']} never left the table: {result}")

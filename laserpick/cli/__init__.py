@@ -1,7 +1,8 @@
 """The `laserpick` console script.
 
-    laserpick serve [--host 127.0.0.1] [--port 8000] [--viser-port 8080] [--scene isolation]
-                    [--journal FILE] [--recorded DIR]
+    laserpick serve [--host 127.0.0.1] [--port 8000] [--viser-port 8080] [--viser-url URL]
+                    [--scene isolation | --recorded DIR] [--journal FILE]
+                    [--viewer-rate HZ] [--lite-view]
     laserpick record OUT --scene NAME [--seed S] [--aim-at-object INSTANCE]
     laserpick adapter switch|joystick ...
     laserpick bench --protocol P [--trials N] [--seed S] [--selection auto|manual]
@@ -29,8 +30,10 @@ laser confirmed on an object if asked (the format: docs/recording.md).
 `bench --compare` lists the attempts that differ between two of its result files.
 
 Exit codes: 0 clean shutdown (or a finished benchmark, or two results with no difference),
-1 a benchmark trial broke off (the others' results are still written) or the compared results
-differ, 2 bad usage (unknown scene, refused host, a bad count, an unreadable result file)."""
+1 a benchmark trial broke off (the others' results are still written), the compared results
+differ, the API could not start (`serve`), no camera sees the object to aim at (`record`) or
+a scripted wait timed out (`adapter`); 2 bad usage (unknown scene, refused host, a bad count,
+an unreadable result file)."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ __all__ = ["add_adapter_parser", "cmd_adapter"]
 
 def add_adapter_parser(sub: argparse._SubParsersAction) -> None:
     """`laserpick adapter switch|joystick`: accessibility input adapters, run as separate
-    clients of a server's public API (see `laserpick/adapters/` and the README)."""
+    clients of a server's public API (see `laserpick/adapters/` and docs/adapters.md)."""
     adapter = sub.add_parser(
         "adapter", help="run an input adapter (switch, joystick) against a running server"
     )

@@ -1,7 +1,7 @@
 """Collision geometry of the robot for planning: the UR5's link capsules, the gripper's, and
 keep-out boxes around the scooter and its rider.
 
-The same tables build the MuJoCo model (robot/sim/model.py) and the planner's sphere model and
+The same tables build the MuJoCo model (robot/sim/model/) and the planner's sphere model and
 keep-out boxes (pipeline/collision/), so what the planner avoids is what the simulator
 collides: the link capsules, the joint housings around each joint, and the boxes of the
 cameras and the projector on the scooter's posts.

@@ -17,8 +17,7 @@ class ServerSettings(BaseModel):
         0.5,
         gt=0,
         le=2.0,
-        description="Arm or base motion halts when the controller is silent this long (s)."
-        " Issue 5.",
+        description="Arm or base motion halts when the controller is silent this long (s).",
     )
     events_hz: float = Field(
         30.0, ge=1.0, le=100.0, description="State frames per second on the events websocket."
