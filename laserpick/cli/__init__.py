@@ -43,10 +43,11 @@ from collections.abc import Sequence
 
 from laserpick.cli.adapter import add_adapter_parser
 from laserpick.cli.bench import add_bench_parser
+from laserpick.cli.common import EXIT_USAGE
 from laserpick.cli.record import add_record_parser
 from laserpick.cli.serve import add_serve_parser
 
-__all__ = ["build_parser", "main"]
+__all__ = ["EXIT_USAGE", "build_parser", "main"]
 
 
 def build_parser() -> argparse.ArgumentParser:
