@@ -30,7 +30,9 @@ laser confirmed on an object if asked (the format: docs/recording.md).
 
 Exit codes: 0 clean shutdown (or a finished benchmark, or two results with no difference),
 1 a benchmark trial broke off (the others' results are still written) or the compared results
-differ, 2 bad usage (unknown scene, refused host, a bad count, an unreadable result file)."""
+differ, 2 bad usage (unknown scene, refused host, a bad count, an unreadable result file) or
+no way for MuJoCo to render here (`serve`, `record` and `bench` choose its OpenGL backend
+before loading it: `robot.gl_backend`)."""
 
 from __future__ import annotations
 
