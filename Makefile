@@ -1,8 +1,6 @@
 # The two commands of the quick start are `make run` and `make test`; both bootstrap `.venv` first.
 SHELL := /bin/bash
 VENV := .venv/bin
-export MUJOCO_GL ?= egl
-export PYOPENGL_PLATFORM ?= egl
 
 .PHONY: bootstrap run test test-slow lint bench bench-rtf bench-api
 

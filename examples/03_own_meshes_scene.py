@@ -24,9 +24,8 @@ import numpy as np
 import trimesh
 
 from laserpick.pipeline.cloud import fuse
+from laserpick.robot.gl_backend import choose_gl_backend
 from laserpick.robot.recording import Recording, capture_from, write_recording
-from laserpick.robot.sim import SceneError, load_scene
-from laserpick.robot.sim.truth import SimTruth, capture
 
 SCENE = """\
 name: my_desk
@@ -56,6 +55,9 @@ def main() -> int:
     parser.add_argument("--dir", type=Path, help="where to write the mesh and the scene")
     parser.add_argument("--record", type=Path, metavar="OUT", help="save the capture here")
     args = parser.parse_args()
+    choose_gl_backend()  # before the simulator loads MuJoCo: EGL or OSMesa if MUJOCO_GL is unset
+    from laserpick.robot.sim import SceneError, load_scene
+    from laserpick.robot.sim.truth import SimTruth, capture
 
     with tempfile.TemporaryDirectory(prefix="laserpick-scene-") as tmp:
         directory = args.dir or Path(tmp)

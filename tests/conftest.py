@@ -1,6 +1,7 @@
-"""Shared test setup: headless EGL rendering for MuJoCo, before anything imports it."""
+"""Shared test setup: MuJoCo's OpenGL backend chosen before anything imports it (`MUJOCO_GL`
+if set, else EGL or OSMesa, whichever renders here); the servers and workers the tests start
+inherit the choice through the environment."""
 
-import os
+from laserpick.robot.gl_backend import choose_gl_backend
 
-os.environ.setdefault("MUJOCO_GL", "egl")
-os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+choose_gl_backend()

@@ -34,7 +34,8 @@ def stop_process(proc: subprocess.Popen) -> None:
 
 class ServeProcess:
     """`laserpick serve` on free (or given) ports with its journal in `tmp`; stdout is read
-    by a thread, stderr goes to a file. `start()` waits for the ready line."""
+    by a thread, stderr goes to a file. `start()` waits for the ready line. `env` adds to
+    this process's environment, or removes a variable given None."""
 
     def __init__(
         self,
@@ -43,7 +44,7 @@ class ServeProcess:
         scene: str = "isolation",
         api_port: int | None = None,
         viser_port: int | None = None,
-        env: dict[str, str] | None = None,
+        env: dict[str, str | None] | None = None,
         extra_args: tuple[str, ...] = (),
     ) -> None:
         self.tmp = tmp
@@ -53,10 +54,13 @@ class ServeProcess:
         self.url = f"http://127.0.0.1:{self.api_port}"
         self.viser_url = f"http://127.0.0.1:{self.viser_port}"
         full_env = dict(os.environ)
-        full_env["MUJOCO_GL"] = "egl"
         full_env.pop("LASERPICK_OPERATOR_PASSWORD", None)
         full_env["PYTHONPATH"] = str(REPO) + os.pathsep + full_env.get("PYTHONPATH", "")
-        full_env.update(env or {})
+        for name, value in (env or {}).items():
+            if value is None:
+                full_env.pop(name, None)
+            else:
+                full_env[name] = value
         self.stderr_path = tmp / "serve.stderr"
         self._stderr = self.stderr_path.open("w")
         self.proc = subprocess.Popen(

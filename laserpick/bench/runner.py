@@ -2,7 +2,8 @@
 
 Trial k of a run with seed s has seed s + k and depends on nothing else, so the three ways
 give the same attempts for the same seed (only the timings differ). Each worker process
-builds its own simulator; MuJoCo renders headless through EGL in each.
+builds its own simulator; MuJoCo renders in each with the OpenGL backend chosen before the
+run (`robot.gl_backend`), which local workers inherit through the environment.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 
 from laserpick.bench.protocols import PROTOCOLS, Options
 from laserpick.bench.results import result
+from laserpick.robot.gl_backend import choose_gl_backend
 
 Record = dict[str, Any]
 
@@ -30,8 +32,8 @@ Outcome = tuple[list[Record], str | None]
 def run_trial(protocol: str, trial: int, seed: int, options: Options) -> Outcome:
     """One trial's attempt records (JSON-ready), or why the trial broke off: the unit of work
     a worker runs. A trial that raises is reported, not lost with the rest of the run."""
-    os.environ.setdefault("MUJOCO_GL", "egl")
     try:
+        choose_gl_backend()  # a check here: this process has imported MuJoCo already
         attempts = PROTOCOLS[protocol].run(trial, seed, options)
     except Exception as exc:
         detail = traceback.format_exc(limit=-3)
@@ -106,6 +108,8 @@ def run(
 ) -> dict[str, Any]:
     """Run `trials` trials of `protocol` (default: the paper's number) and return the result
     JSON. progress(done, total, records so far) is called after each finished trial."""
+    if not ray_address:  # here or in workers inheriting this environment: check it once
+        choose_gl_backend()
     spec = PROTOCOLS[protocol]
     options = options or Options(selection=spec.selection, strategy=spec.strategy)
     n = spec.trials if trials is None else trials

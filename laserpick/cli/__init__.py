@@ -33,7 +33,8 @@ Exit codes: 0 clean shutdown (or a finished benchmark, or two results with no di
 1 a benchmark trial broke off (the others' results are still written), the compared results
 differ, the API could not start (`serve`), no camera sees the object to aim at (`record`) or
 a scripted wait timed out (`adapter`); 2 bad usage (unknown scene, refused host, a bad count,
-an unreadable result file)."""
+an unreadable result file) or no way for MuJoCo to render here (`serve`, `record` and
+`bench` choose its OpenGL backend before loading it: `robot.gl_backend`)."""
 
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ import argparse
 import os
 from pathlib import Path
 
-from laserpick.cli.common import EXIT_USAGE, say
+from laserpick.cli.common import EXIT_USAGE, rendering_problem, say
 
 __all__ = ["add_bench_parser", "cmd_bench"]
 
@@ -90,6 +90,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def run_bench(args: argparse.Namespace) -> int:
     """Run the protocol of `args` with a progress bar; write the JSON, the report and the
     plots."""
+    problem = rendering_problem()
+    if problem is not None:  # before the simulator loads, so that the workers inherit the choice
+        say(problem, err=True)
+        return EXIT_USAGE
+
     import json
 
     from laserpick.bench.protocols import PROTOCOLS, Options

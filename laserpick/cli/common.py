@@ -1,5 +1,5 @@
 """What every `laserpick` subcommand shares: how it speaks, exit codes, loopback checks, the
-journal's default place."""
+journal's default place, and the check that MuJoCo can render before it is loaded."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ __all__ = [
     "STOP_SIGNALS",
     "default_journal",
     "is_loopback",
+    "rendering_problem",
     "say",
     "url_host",
 ]
@@ -59,3 +60,15 @@ def default_journal() -> Path:
     """Where the journal lives by default: $XDG_DATA_HOME/laserpick/journal.sqlite3."""
     root = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
     return Path(root) / "laserpick" / "journal.sqlite3"
+
+
+def rendering_problem() -> str | None:
+    """Why MuJoCo cannot render here (one sentence naming what to install or set), or None
+    once its OpenGL backend is chosen. Call before anything imports the simulator."""
+    from laserpick.robot.gl_backend import GLBackendError, choose_gl_backend
+
+    try:
+        choose_gl_backend()
+    except GLBackendError as exc:
+        return str(exc)
+    return None

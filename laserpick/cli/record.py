@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from laserpick.cli.common import EXIT_USAGE, say
+from laserpick.cli.common import EXIT_USAGE, rendering_problem, say
 
 __all__ = ["add_record_parser", "cmd_record"]
 
@@ -32,12 +32,17 @@ def add_record_parser(sub: argparse._SubParsersAction) -> None:
 def cmd_record(args: argparse.Namespace) -> int:
     """Simulate a scene headless, let it settle, confirm the laser on an object if asked,
     capture once, and write the recording to `args.out`."""
-    from laserpick.robot.sim.scenes import load_scene
-
     out: Path = args.out
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         say(f"{out} already exists and is not an empty directory; choose another", err=True)
         return EXIT_USAGE
+    problem = rendering_problem()
+    if problem is not None:
+        say(problem, err=True)
+        return EXIT_USAGE
+
+    from laserpick.robot.sim.scenes import load_scene
+
     try:
         scene = load_scene(args.scene, seed=args.seed)
     except Exception as exc:

@@ -17,6 +17,7 @@ from laserpick.cli.common import (
     STOP_SIGNALS,
     default_journal,
     is_loopback,
+    rendering_problem,
     say,
     url_host,
 )
@@ -178,6 +179,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     if args.recorded is not None:
         return serve_recording(args)
+    problem = rendering_problem()
+    if problem is not None:
+        say(problem, err=True)
+        return EXIT_USAGE
 
     # Heavy imports only once the arguments are sane: `laserpick --help` stays fast.
     from laserpick.robot.sim.scenes import load_scene

@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
+from laserpick.robot.gl_backend import choose_gl_backend
 from laserpick.robot.interface import GripperState, JointState, MotionHandle, RobotState
 from laserpick.robot.sim.laser import SimLaser
 from laserpick.robot.sim.loop import Simulation, Snapshot
@@ -27,11 +28,15 @@ from laserpick.types import DepthFrame, Projector, Trajectory
 
 
 class SimRobot:
-    """A `Robot` backed by MuJoCo. `realtime=False` gives the deterministic headless mode."""
+    """A `Robot` backed by MuJoCo. `realtime=False` gives the deterministic headless mode.
+
+    Built only where MuJoCo can render (`gl_backend.choose_gl_backend`, GLBackendError
+    otherwise): its cameras are what the session perceives with."""
 
     def __init__(
         self, scene: Scene | None, *, realtime: bool = True, settings: Settings | None = None
     ) -> None:
+        choose_gl_backend()
         self.settings = settings or get_settings()
         self.sim = Simulation(scene, realtime=realtime, settings=self.settings)
         self.laser = SimLaser(self.sim.model)

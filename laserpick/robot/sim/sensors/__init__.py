@@ -43,8 +43,9 @@ optical frame in `base`: MuJoCo's camera frame (looking along -z, +y up) times d
 
 Threading: the OpenGL context belongs to the thread that creates it, and this class creates
 it lazily on the first capture. Use one `DepthCameras` from one thread only (the capture
-thread); it raises if called from another. `MUJOCO_GL` (egl for headless) must be set before
-mujoco is first imported.
+thread); it raises if called from another. MuJoCo's GL backend must be chosen before mujoco
+is first imported (`laserpick.robot.gl_backend`). If the GL setup fails, every capture of the
+process raises `RenderingUnavailable` without trying again (a second try can abort it).
 """
 
 from laserpick.robot.sim.sensors.cameras import CAM_TO_OPTICAL, DepthCameras
@@ -62,6 +63,7 @@ from laserpick.robot.sim.sensors.noise import NOISE_POOL, SensorNoise, noisy_dep
 from laserpick.robot.sim.sensors.render import (
     DEPTH_GEOMGROUP,
     LABEL_GEOMGROUP,
+    RenderingUnavailable,
     SegmentationRenderer,
     render_option,
 )
@@ -79,6 +81,7 @@ __all__ = [
     "NOISE_POOL",
     "DepthCameras",
     "IrShading",
+    "RenderingUnavailable",
     "SegmentationRenderer",
     "SensorNoise",
     "draw_laser_dots",

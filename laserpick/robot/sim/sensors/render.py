@@ -3,9 +3,12 @@ from one segmentation pass, and the geom groups each kind of image shows."""
 
 from __future__ import annotations
 
+import threading
+
 import mujoco
 import numpy as np
 
+from laserpick.robot.gl_backend import loaded_backend
 from laserpick.robot.sim.objects import GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR, GROUP_TRANSPARENT
 
 #: Geom groups the depth sensor sees: surfaces/opaque (0), robot (1), specular (3).
@@ -13,6 +16,41 @@ DEPTH_GEOMGROUP = tuple(int(g in (GROUP_OPAQUE, GROUP_ROBOT, GROUP_SPECULAR)) fo
 #: Geom groups in the ground-truth label image: everything physical, transparent included.
 _PHYSICAL = (GROUP_OPAQUE, GROUP_ROBOT, GROUP_TRANSPARENT, GROUP_SPECULAR)
 LABEL_GEOMGROUP = tuple(int(g in _PHYSICAL) for g in range(6))
+
+
+class RenderingUnavailable(RuntimeError):
+    """MuJoCo could not set up OpenGL rendering in this process, so the cameras cannot
+    render; every later renderer raises it again without a new attempt."""
+
+
+#: Why the first GL setup of this process failed, once one has. A failed `MjrContext` leaves
+#: a C++ static initialiser in MuJoCo half done: a second attempt aborts the process (on the
+#: same thread) or hangs it holding the GIL (on another), so none is made.
+_setup_failure: str | None = None
+_setup_lock = threading.Lock()
+
+
+def gl_setup(
+    model: mujoco.MjModel, width: int, height: int
+) -> tuple[mujoco.GLContext, mujoco.MjrContext]:
+    """An offscreen GL context of `width` x `height` pixels, current on this thread, and
+    MuJoCo's render context for `model` in it. RenderingUnavailable if that failed, now or
+    before in this process."""
+    global _setup_failure
+    with _setup_lock:
+        if _setup_failure is not None:
+            raise RenderingUnavailable(_setup_failure)
+        try:
+            gl = mujoco.GLContext(width, height)
+            gl.make_current()
+            return gl, mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+        except Exception as exc:
+            why = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+            _setup_failure = (
+                f"the cameras cannot render: MuJoCo's {loaded_backend()} backend made no OpenGL"
+                f" context ({why}); restart laserpick where it can (docs/robot.md)"
+            )
+            raise RenderingUnavailable(_setup_failure) from exc
 
 
 def render_option(groups: tuple[int, ...]) -> mujoco.MjvOption:
@@ -34,9 +72,7 @@ class SegmentationRenderer:
 
     def __init__(self, model: mujoco.MjModel, width: int, height: int) -> None:
         self.width, self.height = width, height
-        self.gl = mujoco.GLContext(width, height)
-        self.gl.make_current()
-        self.con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+        self.gl, self.con = gl_setup(model, width, height)
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.con)
         # Reversed z with a float buffer: precise metric depth far away.
         self.con.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
