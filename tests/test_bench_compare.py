@@ -132,6 +132,23 @@ def test_other_options_are_noted(old: dict[str, Any]) -> None:
     assert comparison.same and comparison.notes == ("option tremor_deg differs: 0.3 -> 0.5",)
 
 
+def test_other_commits_are_noted_not_counted_as_differences(old: dict[str, Any]) -> None:
+    """A comparison is for a change of code: another commit, an unclean tree or a result
+    written before commits were recorded is a note, and the attempts still match."""
+    a = old | {"commit": "a" * 40, "tree_clean": True}
+    b = copy.deepcopy(old) | {"commit": "b" * 40, "tree_clean": False}
+    comparison = compare_results(a, b)
+    assert comparison.same
+    assert comparison.notes == (
+        f"commit differs: {'a' * 40} -> {'b' * 40}",
+        "the new run's tree had uncommitted changes",
+    )
+    assert compare_results(old, a).notes == (f"commit differs: not recorded -> {'a' * 40}",)
+    assert compare_results(a, copy.deepcopy(a)).notes == ()
+    text = format_comparison(comparison, "a.json", "b.json")
+    assert "note: commit differs" in text and "no difference: all 4 attempts match" in text
+
+
 def test_unreadable_files_are_refused(tmp_path: Path) -> None:
     with pytest.raises(ResultFileError, match="cannot read"):
         load_result(tmp_path / "missing.json")

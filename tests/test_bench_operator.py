@@ -9,7 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from laserpick.bench.picking import BENCH, LEVER_MAX, ScriptedOperator, lever, open_session
+from laserpick.bench.picking import (
+    BENCH,
+    LEVER_MAX,
+    ScriptedOperator,
+    lever,
+    open_session,
+    seen_middle,
+)
 from laserpick.bench.protocols import Options, scripted_operator
 from laserpick.bench.protocols.jeeves import JEEVES_MODELS, jeeves_scene
 from laserpick.bench.protocols.laser_scan import scan_points
@@ -97,13 +104,14 @@ def test_a_grasps_lever_is_its_objects_weight_arm_about_the_line_between_the_fin
 
 
 def test_choosing_by_hand_the_user_holds_across_the_middle_and_toggles_on(tmp_path: Path) -> None:
-    """A TV remote lying across the table, its weight 4 cm toward one end (where its
-    batteries are): the best clusters hold it off its weight, where it would swing in the
-    pads; the user steps past them to the first that holds it across its weight, as a
-    person who knows the object would. The simulated remote is uniform, so the test hands
-    the user that centre of mass: since G_b is the hand's bottom (selection.hand_bottom), the
-    system itself ranks a grasp across the uniform remote's middle first. Told that grasp
-    failed to plan, the user passes its cluster by the next time."""
+    """A TV remote lying across the table. Seen whole, the middle of what the user sees is
+    its middle, and the system's best cluster holds it there (G_b is the hand's bottom,
+    selection.hand_bottom): the user takes it. With 8 cm of one end hidden from them (the
+    test cuts it from what the cameras saw), the middle they see lies 4 cm toward the other
+    end: the best clusters hold it off that middle, and the user steps past them to the
+    first that holds it across it (a grasp on the hidden end is not on the remote as they
+    see it). Told that grasp failed to plan, the user passes its cluster by the next
+    time."""
     scene = tmp_path / "remote.yaml"
     scene.write_text(
         "name: remote\nscooter: {x: 0.0, y: 0.0, yaw_deg: 0.0}\n"
@@ -114,31 +122,43 @@ def test_choosing_by_hand_the_user_holds_across_the_middle_and_toggles_on(tmp_pa
         s = op.session
         s.set_mode(BENCH, selection="manual", mode="pick_and_place")
         assert op.mark(op.new_attempt("remote", "manual", "gpd"))
-        before = op.referee.all_object_points()
-        # Its long axis, from `world` into `base`.
+        seen = op.referee.view().points()
+        middle = seen_middle(seen["remote"])
+        assert np.linalg.norm((middle - op.referee.centre_of_mass("remote"))[:2]) < 0.01
+        op.choose("remote", seen)
+        assert s.status()["grasps"]["cluster"] == 0
+        # Its long axis, from `world` into `base`; 8 cm of one end hidden.
         ref = op.referee
         origin = ref.world_position("remote")
-        along = matrix_from_quat(ref.world_quat("remote"))[:, 0]
-        length = ref.to_base(origin + along) - ref.to_base(origin)
-        centre = ref.centre_of_mass("remote") - 0.04 * length
-        levers = []
+        along = ref.to_base(origin + matrix_from_quat(ref.world_quat("remote"))[:, 0])
+        along -= ref.to_base(origin)
+        reach = (seen["remote"] - middle) @ along
+        seen["remote"] = seen["remote"][reach > reach.min() + 0.08]
+        middle = seen_middle(seen["remote"])
+        on, levers = [], []  # per cluster: on the remote as the user sees it; lever (m)
         for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
             pose = np.asarray(s.status()["current"]["pose"])
-            assert op.referee.object_at(pose[:3, 3], before) == "remote"
-            levers.append(lever(pose, centre))
-        assert levers[0] > LEVER_MAX, "this remote's best cluster should hold it off its weight"
-        op.choose("remote", before, centre)
+            on.append(op.referee.object_at(pose[:3, 3], seen) == "remote")
+            levers.append(lever(pose, middle))
+        assert on[0] and levers[0] > LEVER_MAX, "the best cluster should hold it off that middle"
+        balanced = [k for k, x in enumerate(levers) if on[k] and x <= LEVER_MAX]
+        op.choose("remote", seen)
         chosen = s.status()["grasps"]["cluster"]
-        assert levers[chosen] <= LEVER_MAX
-        assert all(x > LEVER_MAX for x in levers[:chosen])
+        assert balanced and chosen == balanced[0]
         # That grasp failed to plan: on the next try the user toggles past its cluster.
         op.saw_unplanned("remote", np.asarray(s.status()["current"]["position"]))
-        op.choose("remote", before, centre)
+        op.choose("remote", seen)
         again = s.status()["grasps"]["cluster"]
-        assert again != chosen
-        balanced = [k for k, x in enumerate(levers) if x <= LEVER_MAX and k != chosen]
-        assert again == (balanced[0] if balanced else 0)
+        others = [k for k in range(len(on)) if on[k] and k != chosen]
+        assert again == ([k for k in others if levers[k] <= LEVER_MAX] or others)[0]
+
+
+def test_the_middle_a_person_sees_is_the_middle_of_the_seen_bounds() -> None:
+    """Hand-worked: points seen densely at one end of a 20 cm object and sparsely at the
+    other; its middle is halfway between its ends, not where most points lie."""
+    pts = np.array([[0.0, 0.0, 0.1], [0.01, 0.0, 0.1], [0.02, 0.01, 0.1], [0.2, 0.02, 0.12]])
+    assert seen_middle(pts) == pytest.approx([0.1, 0.01, 0.11])
 
 
 def test_the_helper_empties_the_basket_of_any_object_after_an_attempt() -> None:

@@ -168,6 +168,14 @@ def test_paper_numbers_appear_with_their_citation(isolation):
     assert "24.2 ± 1.1 s" in execute and "51.7 ± 7.2 s" in _rows(md, "attempt_total")[0]
 
 
+def test_the_header_names_the_commit_and_an_unclean_tree(isolation):
+    assert "commit" not in report.markdown(isolation)  # a result from before it was recorded
+    clean = report.markdown(isolation | {"commit": "c0ffee", "tree_clean": True})
+    assert "laserpick 0.1.0 (commit c0ffee);" in clean
+    dirty = report.markdown(isolation | {"commit": "c0ffee", "tree_clean": False})
+    assert "laserpick 0.1.0 (commit c0ffee, with uncommitted changes);" in dirty
+
+
 def test_targets_below_are_not_met_and_above_are_met(isolation):
     checks = {c.label: c for c in report.check_targets(isolation)}
     grasp = checks[GRASP_TARGET]

@@ -7,8 +7,8 @@ runs (`compare`).
 - `protocols/`: the experiments, one module each; `runner`: their trials inline, in worker
   processes or on Ray; `results`: the result JSON; `attempts`: one attempt's record.
 - `picking`: the scripted operator, through the session; `referee`: the simulator's truth it
-  reads to aim and drive; `parking`, `driving` and `route_planning`: where it parks and how
-  it drives there.
+  reads to aim, choose and drive (each read listed in docs/bench.md); `parking`, `driving`
+  and `route_planning`: where it parks and how it drives there.
 - `papers/`: the papers' published figures; `targets`: ours; `report/`: Markdown and PNG;
   `scoring`: scores against the truth.
 

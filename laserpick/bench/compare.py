@@ -176,9 +176,23 @@ def attempt_changes(old: Record, new: Record, tolerance: float = 0.0) -> tuple[F
     return tuple(changes)
 
 
+def _code_notes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
+    """Which code each run ran, where that differs or is uncertain: the commits (`commit`;
+    "not recorded" in a result written before it was) and trees with uncommitted changes
+    (`tree_clean`). Informational: a change of code is what a comparison is for."""
+    notes = []
+    commits = [r.get("commit", "not recorded") for r in (old, new)]
+    if ("commit" in old or "commit" in new) and commits[0] != commits[1]:
+        notes.append(f"commit differs: {commits[0]} -> {commits[1]}")
+    for which, result in (("old", old), ("new", new)):
+        if result.get("tree_clean") is False:
+            notes.append(f"the {which} run's tree had uncommitted changes")
+    return notes
+
+
 def _run_notes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
     """What differs between the runs besides their attempts."""
-    notes = []
+    notes = _code_notes(old, new)
     if old.get("trials") != new.get("trials"):
         notes.append(f"trials differ: {old.get('trials')} -> {new.get('trials')}")
     old_opt, new_opt = old.get("options") or {}, new.get("options") or {}

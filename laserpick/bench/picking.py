@@ -3,7 +3,8 @@
 It plays the user of 004's experiments: it looks at the scene (the simulator's truth says
 where each object is and how it looks from the cameras), aims the laser at an object's visible
 top with hand-tremor noise, confirms, and, in manual selection, steps through the grasp
-clusters to one on the object it meant, the way a person looking at the outlines would. Every
+clusters to one on the object it meant, the way a person looking at the outlines over what
+they see of the objects would. Every
 command goes through the session's methods with `Actor("bench")`; the pipeline behind it never
 sees the truth. The `Referee` then scores what happened, and the experimenter (`tidy`) resets
 what a helper in the lab would: the basket emptied, a stuck arm moved home by hand.
@@ -21,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from laserpick.bench.attempts import Attempt, stage_timings
-from laserpick.bench.referee import Referee
+from laserpick.bench.referee import Referee, View
 from laserpick.description import dims
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
@@ -52,9 +53,10 @@ AIMS = 5
 DOT_ON_SPOT = 0.03
 #: Longest a session job may take (s of wall time) before the run is declared hung.
 JOB_TIMEOUT = 600.0
-#: The farthest (m) a user choosing by hand lets a grasp hold an object off its balance: an
-#: object held farther from its centre of mass, across the line between the fingers, swings
-#: about that line in the pads (a TV remote held near one end turns onto its side).
+#: The farthest (m) a user choosing by hand lets a grasp hold an object off the middle of
+#: what they see of it: an object held far from its centre of mass, across the line between
+#: the fingers, swings about that line in the pads (a TV remote held near one end turns onto
+#: its side), and a person, who cannot see the centre of mass, holds it across its middle.
 LEVER_MAX = 0.02
 #: How near (m) a cluster's best grasp must lie to one the user saw fail to plan for them to
 #: take it for the same and pass it by: half 004's cluster bound (section 7.2). Neighbouring
@@ -107,6 +109,8 @@ class ScriptedOperator:
         #: Per object, where (m, `world`) grasps the user chose failed to plan: on their next
         #: try they toggle past them, as a person who saw "none could be planned" would.
         self._unplanned: dict[str, list[np.ndarray]] = {}
+        #: The look the user aimed their last mark by (None: they aimed at a given point).
+        self._view: View | None = None
         self._events: list[dict[str, Any]] = []
         # Stamped with the simulated time as they happen (listeners run on the emitting thread).
         session.on_event(lambda e: self._events.append({**e, "sim_time": self._sim_time()}))
@@ -196,7 +200,8 @@ class ScriptedOperator:
         # Aiming at the object, the user looks for the dot on it; aiming at a given point
         # (002's laser scan, which tries points up to the object's edges), they do not.
         on = rec.instance if aim is None else None
-        aim = aim if aim is not None else self.referee.aim_point(rec.instance)
+        self._view = self.referee.view() if aim is None else None
+        aim = aim if self._view is None else self._view.top(rec.instance)
         if aim is None:
             rec.fail("detect_laser", "no camera sees the object")
             return False
@@ -217,24 +222,28 @@ class ScriptedOperator:
         s.cancel(BENCH)
         return False
 
-    def choose(self, instance: str, before: dict[str, np.ndarray], centre: np.ndarray) -> None:
+    def choose(self, instance: str, seen: dict[str, np.ndarray]) -> None:
         """Manual selection (004 section 7.2): step through the clusters, best first, to the
-        first whose best grasp closes on `instance` across its middle (a `lever` of at most
-        LEVER_MAX about its centre of mass `centre`, m, `base`), as a person who sees the
-        object would hold it; else to the first on `instance` at all; none such: back to the
-        system's choice. Clusters where a choice failed to plan before are passed by while
+        first whose best grasp closes on `instance` across its middle, as a person who sees
+        the gripper's outline over the object would hold it; else to the first on `instance`
+        at all; none such: back to the system's choice. What the user sees of each object
+        is `seen`, the points the cameras saw on it (m, `base`; `View.points`): a grasp is
+        on the object whose seen points lie nearest its TCP, within 4 cm, and across its
+        middle with a `lever` of at most LEVER_MAX about the middle of its seen extent
+        (`seen_middle`). Clusters where a choice failed to plan before are passed by while
         another on `instance` is left: a person does not choose again what they saw fail."""
         s = self.session
         failed = self._unplanned.get(instance, [])
+        middle = seen_middle(seen[instance]) if instance in seen else None
         best: tuple[tuple[bool, bool], int] | None = None  # (tried, off balance), cluster
         for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
             pose = np.asarray(s.status()["current"]["pose"])
-            if self.referee.object_at(pose[:3, 3], before) != instance:
+            if middle is None or self.referee.object_at(pose[:3, 3], seen) != instance:
                 continue
             at = self.referee.to_world(pose[:3, 3])
             tried = any(np.linalg.norm(at - p) < UNPLANNED_NEAR for p in failed)
-            rank = (tried, lever(pose, centre) > LEVER_MAX)
+            rank = (tried, lever(pose, middle) > LEVER_MAX)
             if rank == (False, False):
                 return
             if best is None or rank < best[0]:
@@ -259,9 +268,11 @@ class ScriptedOperator:
         if not self.mark(rec, aim):
             return False
         before = self.referee.all_object_points()  # judge grasps by the scene they were made for
-        centre = self.referee.centre_of_mass(rec.instance)
+        centre = self.referee.centre_of_mass(rec.instance)  # the referee's, for `rec.lever`
         if rec.selection == "manual":
-            self.choose(rec.instance, before, centre)
+            # The user chooses by what they see: the look they aimed by (nothing has moved
+            # since), or, where they aimed at a given point, a look now.
+            self.choose(rec.instance, (self._view or self.referee.view()).points())
         chosen = np.asarray(s.status()["current"]["position"])
         k = len(self._events)
         t_sim = self._sim_time()
@@ -357,6 +368,14 @@ class ScriptedOperator:
             # the fingers into the furniture.
             self.referee.move_arm_home()
         s.resync(BENCH)
+
+
+def seen_middle(points: np.ndarray) -> np.ndarray:
+    """The middle of what the cameras saw of an object (m, `base`): the middle of the bounds
+    of its seen `points` (n, 3). Where a person would take an object's middle to be: its
+    visible extent, not its centre of mass, which no one sees."""
+    pts = np.asarray(points, dtype=float)
+    return (pts.min(axis=0) + pts.max(axis=0)) / 2
 
 
 def lever(pose: np.ndarray, centre: np.ndarray) -> float:

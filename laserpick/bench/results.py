@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import platform
 import statistics
+import subprocess
 from collections.abc import Iterable, Sequence
 from datetime import UTC, datetime
 from importlib import metadata
+from pathlib import Path
 from typing import Any
 
 from laserpick.bench import FAILURE_KINDS, STAGES
@@ -35,6 +37,37 @@ RESULT_PACKAGES = (
     "pin",
     "ur-analytic-ik",
 )
+
+
+#: The checkout's folder that bench runs write into by default: a run's own results do not
+#: make its tree unclean.
+RESULTS_FOLDER = "bench-results"
+
+
+def _git(root: Path, *args: str) -> str | None:
+    """`git -C root ARGS`'s output, stripped; None when git is missing or fails."""
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(root), *args], capture_output=True, text=True, timeout=30
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return done.stdout.strip() if done.returncode == 0 else None
+
+
+def source_revision(root: Path | None = None) -> dict[str, Any]:
+    """The code a run ran: `commit`, the checked-out commit (`git rev-parse HEAD`) of the git
+    checkout whose top folder is `root` (default: the one laserpick is imported from), and
+    `tree_clean`, whether that checkout had no changes, staged, unstaged or untracked, but
+    in RESULTS_FOLDER. Where `root` is not the top of a git checkout (laserpick installed
+    from a wheel, or git missing): commit "unknown" and tree_clean None."""
+    root = Path(__file__).resolve().parents[2] if root is None else Path(root).resolve()
+    top = _git(root, "rev-parse", "--show-toplevel")
+    commit = _git(root, "rev-parse", "HEAD")
+    if top is None or Path(top).resolve() != root or not commit:
+        return {"commit": "unknown", "tree_clean": None}
+    changes = _git(root, "status", "--porcelain", "--", ".", f":(exclude){RESULTS_FOLDER}")
+    return {"commit": commit, "tree_clean": None if changes is None else changes == ""}
 
 
 def environment() -> dict[str, Any]:
@@ -153,6 +186,7 @@ def result(
     out["records"] = records
     out["wall_time_s"] = round(wall_time_s, 1)
     out["version"] = __version__
+    out.update(source_revision())
     out["environment"] = environment()
     out["created"] = datetime.now(UTC).isoformat(timespec="seconds")
     return out

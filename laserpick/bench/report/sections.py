@@ -16,6 +16,16 @@ from laserpick.bench.report.measures import Summary, failures, modes, ours_text,
 from laserpick.bench.report.text import DASH, fraction, markdown_table, seconds
 
 
+def _revision(result: dict[str, Any]) -> str:
+    """The commit a run ran on, as the header shows it: " (commit C)", marked where its tree
+    had uncommitted changes; nothing for a result that did not record it."""
+    commit = result.get("commit")
+    if commit is None:
+        return ""
+    dirty = ", with uncommitted changes" if result.get("tree_clean") is False else ""
+    return f" (commit {commit}{dirty})"
+
+
 def _header(result: dict[str, Any], ref: Reference) -> list[str]:
     p = result["protocol"]
     lines = [f"# laserpick bench: {p} (seed {result.get('seed')}, {result.get('trials')} trials)"]
@@ -24,7 +34,7 @@ def _header(result: dict[str, Any], ref: Reference) -> list[str]:
         "",
         f"{result.get('attempts', 0)} grasp attempts on {result.get('tasks', 0)} tasks; "
         f"wall time {result.get('wall_time_s', 0.0):.0f} s; "
-        f"laserpick {result.get('version', '?')}; "
+        f"laserpick {result.get('version', '?')}{_revision(result)}; "
         f"created {result.get('created', '?')}.",
     ]
     env = result.get("environment")
