@@ -16,7 +16,9 @@
 - Malformed frames on the events websocket (binary, over the size limit, not JSON, JSON of
   the wrong shape or types, unknown message names, nesting deeper than the parser goes) are
   answered with an error or the socket is closed with a clean code; `GET /health` still
-  answers 200 after each, and the lease holder keeps its lease.
+  answers 200 after each, and the lease holder keeps its lease. Nonsense on the 3D view's
+  websocket (viser's own code, which drops that socket) leaves the server and the view
+  answering.
 
     MUJOCO_GL=egl .venv/bin/python -m pytest -q tests/test_security.py
 """
@@ -114,9 +116,14 @@ def test_control_without_the_password_is_401_and_takes_nothing(
 ) -> None:
     assert not lease_of(server)["held"]
     r = requests.post(f"{server.url}{API}/control", json=body, timeout=10)
-    assert r.status_code == 401, r.text
-    assert "token" not in r.json()
-    assert lease_of(server) == {"held": False, "holder": None, "source": None}
+    taken = r.json().get("token") if r.ok else None
+    try:
+        assert r.status_code == 401, r.text
+        assert lease_of(server) == {"held": False, "holder": None, "source": None}
+    finally:  # a lease wrongly given is given back, so that it fails only this test
+        if taken is not None:
+            auth = {"Authorization": f"Bearer {taken}"}
+            requests.delete(f"{server.url}{API}/control", headers=auth, timeout=10)
 
 
 def test_the_right_password_gives_a_token_that_commands(server: ServeProcess) -> None:
@@ -394,3 +401,49 @@ def test_a_malformed_websocket_frame_never_hurts_the_server(
             f.seek(logged)
             errors = f.read()
         assert "Traceback" not in errors, errors[-3000:]
+
+
+# --- malformed frames on the 3D view's websocket ---------------------------------------------
+
+
+def _msgpack_map(**fields: str) -> bytes:
+    """A msgpack map of short strings (what viser's messages are), written out by hand."""
+
+    def text(s: str) -> bytes:
+        data = s.encode()
+        assert len(data) < 32
+        return bytes([0xA0 | len(data)]) + data
+
+    return bytes([0x80 | len(fields)]) + b"".join(text(k) + text(v) for k, v in fields.items())
+
+
+VIEW_MALFORMED: dict[str, str | bytes] = {
+    "text": json.dumps({"type": "GuiUpdateMessage"}),
+    "not msgpack": b"\xc1\xc1\xc1 not msgpack",
+    "unknown message": _msgpack_map(type="NoSuchMessage"),
+    "known message, no fields": _msgpack_map(type="GuiUpdateMessage"),
+    "wrong types": _msgpack_map(type="ViewerCameraMessage", wxyz="up", position="far"),
+}
+
+
+@pytest.mark.parametrize("frame", list(VIEW_MALFORMED.values()), ids=list(VIEW_MALFORMED))
+def test_a_malformed_3d_view_frame_never_hurts_the_server(
+    server: ServeProcess, frame: str | bytes
+) -> None:
+    """The 3D view's websocket (viser's own code) may drop the socket that sent nonsense,
+    but the server, its API and the view for everyone else carry on."""
+    import viser
+
+    url = f"ws://127.0.0.1:{server.viser_port}/"
+    protocol = [f"viser-v{viser.__version__}"]
+    with connect(url, subprotocols=protocol, max_size=2**26) as ws:  # type: ignore[list-item]
+        ws.recv(timeout=10)  # the scene starts arriving
+        with contextlib.suppress(ConnectionClosed, TimeoutError):
+            ws.send(frame)
+            end = time.monotonic() + 3.0
+            while time.monotonic() < end:  # until it closes, or for 3 s
+                ws.recv(timeout=1.0)
+    assert server.proc.poll() is None
+    assert requests.get(f"{server.url}{API}/health", timeout=10).status_code == 200
+    with connect(url, subprotocols=protocol, max_size=2**26) as ws:  # type: ignore[list-item]
+        assert ws.recv(timeout=10)  # a fresh viewer still gets the scene
