@@ -34,14 +34,16 @@ def stop_process(proc: subprocess.Popen) -> None:
 
 class ServeProcess:
     """`laserpick serve` on free (or given) ports with its journal in `tmp`; stdout is read
-    by a thread, stderr goes to a file. `start()` waits for the ready line. `env` adds to
-    this process's environment, or removes a variable given None."""
+    by a thread, stderr goes to a file. `start()` waits for the ready line. host: its
+    `--host` (None: not passed, so the server binds its default). `env` adds to this
+    process's environment, or removes a variable given None."""
 
     def __init__(
         self,
         tmp: Path,
         *,
         scene: str = "isolation",
+        host: str | None = "127.0.0.1",
         api_port: int | None = None,
         viser_port: int | None = None,
         env: dict[str, str | None] | None = None,
@@ -65,7 +67,8 @@ class ServeProcess:
         self._stderr = self.stderr_path.open("w")
         self.proc = subprocess.Popen(
             [
-                *[sys.executable, "-m", "laserpick.cli", "serve", "--host", "127.0.0.1"],
+                *[sys.executable, "-m", "laserpick.cli", "serve"],
+                *(["--host", host] if host is not None else []),
                 *["--port", str(self.api_port), "--viser-port", str(self.viser_port)],
                 *["--scene", scene, "--journal", str(self.journal)],
                 *extra_args,

@@ -7,17 +7,18 @@ every generated request, so commands reach the session instead of stopping at 40
 
 1. Every operation gets schemathesis's stateless phases (the schema's examples; the coverage
    phase's boundary values, negative cases and unexpected methods; then `MAX_EXAMPLES`
-   fuzzed cases, positive and negative), derandomized, with no deadline. Each response is
-   checked: no 5xx; a status code the schema documents (200, 401, 409, 413, 422; 405 for a
-   method the path lacks); the content type and body the schema gives for it; invalid input
-   refused with a 4xx; and, after a command's first success, the same request without the
-   token or with a made-up one refused with 401. Between cases the session is put back where
-   commands reach it: a pressed e-stop is reset, a released lease retaken (and the cases made
-   before then given the new token).
+   fuzzed cases, positive data (valid by the schema) and negative), derandomized, with no
+   deadline. Each response is checked: no 5xx; a status code the schema documents (200, 401,
+   409, 413, 422; 405 for a method the path lacks); the content type and body the schema
+   gives for it; invalid input refused with a 4xx; schema-valid input not refused as
+   malformed (`schema_valid_input_is_not_malformed`); and, after a command's first success,
+   the same request without the token or with a made-up one refused with 401. Between cases
+   the session is put back where commands reach it: a pressed e-stop is reset, a released
+   lease retaken (and the cases made before then given the new token).
 2. Every command without the token, or with a made-up one: 401, as documented.
 3. A body over the limit, declared or chunked: 413; a body that is not UTF-8: 422.
 4. The fuzzing meant something: every command was answered by the session (not just 401),
-   and nudge, drive and mode succeeded.
+   nudge, drive and mode succeeded, and positive data reached every operation.
 
 `POST /api/v1/scene` gets `SCENE_EXAMPLES` fuzzed cases, and its cases that name a built-in
 scene are not sent: each reset takes about 2 s (tests/test_scenes.py covers loading scenes).
@@ -55,6 +56,45 @@ BUILTIN_SCENES = frozenset(builtin_scene_names())
 
 #: Status codes seen per operation label, e.g. "POST /api/v1/laser/nudge" (for test 4).
 _statuses: defaultdict[str, Counter[int]] = defaultdict(Counter)
+#: Positive (schema-valid) cases sent per operation label (for test 4).
+_positive_sent: Counter[str] = Counter()
+
+#: Pydantic's error types for what the schema itself states (types, bounds, enums, required
+#: and unknown fields): a 422 of one of these to schema-valid input means the schema and the
+#: app's models disagree. "value_error" is not among them: a rule the schema cannot state
+#: (exactly one of `yaw`/`pitch`, `point` or `ray`) or the session's own refusal.
+_SHAPE_ERRORS = frozenset(
+    {
+        "missing",
+        "extra_forbidden",
+        "literal_error",
+        "enum",
+        "json_invalid",
+        "json_type",
+        "model_attributes_type",
+        "dict_type",
+        "list_type",
+        "string_type",
+        "int_type",
+        "int_parsing",
+        "int_from_float",
+        "float_type",
+        "float_parsing",
+        "finite_number",
+        "bool_type",
+        "bool_parsing",
+        "greater_than",
+        "greater_than_equal",
+        "less_than",
+        "less_than_equal",
+        "string_too_short",
+        "string_too_long",
+        "string_pattern_mismatch",
+        "too_short",
+        "too_long",
+        "missing_argument",
+    }
+)
 
 
 class _Lease:
@@ -125,6 +165,7 @@ def api_schema(server_url: str, lease: _Lease) -> schemathesis.BaseSchema:
                 "deterministic": True,
                 "database": "none",
                 "no-shrink": True,
+                "mode": "all",  # positive (schema-valid) and negative data
                 # Fuzz bodies and parameters under the lease's token; requests without it,
                 # or with a made-up one, are the `ignored_auth` check's and test 2's job.
                 "with-security-parameters": False,
@@ -179,14 +220,58 @@ def _builtin_scene(case: Case) -> bool:
     return case.operation.path == f"{API}/scene" and name in BUILTIN_SCENES
 
 
+def is_positive(case: Case) -> bool:
+    """Whether schemathesis generated `case` as valid by the schema."""
+    meta = case.meta
+    return meta is not None and meta.generation.mode.is_positive
+
+
+def _sent(body: Any, loc: list[Any]) -> Any:
+    """The value `body` holds at a 422's `loc` (after its leading "body"), or None."""
+    for key in loc[1:]:
+        try:
+            body = body[key]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return body
+
+
+def _integral_float(error: dict[str, Any], body: Any) -> bool:
+    """JSON Schema counts 8438.0 an integer; the app's strict models want it written 8438.
+    A refusal of that spelling is the one disagreement this check lets pass."""
+    sent = _sent(body, error.get("loc", []))
+    return error.get("type") == "int_type" and isinstance(sent, float) and sent.is_integer()
+
+
+def schema_valid_input_is_not_malformed(ctx: Any, response: Any, case: Case) -> bool | None:
+    """A schema-valid (positive) case is not refused as malformed: no 400 or 413, and a 422
+    only for a rule the schema cannot state, never for one it does (`_SHAPE_ERRORS`)."""
+    if not is_positive(case):
+        return None
+    assert response.status_code not in (400, 413), f"schema-valid input refused: {response.text}"
+    if response.status_code == 422:
+        detail = response.json().get("detail")
+        errors = [e for e in detail if isinstance(e, dict)] if isinstance(detail, list) else []
+        shape = [
+            e
+            for e in errors
+            if e.get("type") in _SHAPE_ERRORS and not _integral_float(e, case.body)
+        ]
+        assert not shape, f"schema-valid input refused as malformed: {shape}"
+    return None
+
+
 @schema.parametrize()
 def test_api_conforms_to_its_schema(case: Case, lease: _Lease) -> None:
     if _builtin_scene(case):
         return
     lease.update(case)
     try:
-        response = case.call_and_validate(timeout=30)
+        response = case.call_and_validate(
+            timeout=30, additional_checks=[schema_valid_input_is_not_malformed]
+        )
         _statuses[case.operation.label][response.status_code] += 1
+        _positive_sent[case.operation.label] += is_positive(case)
     finally:
         try:
             lease.restore()
@@ -266,3 +351,5 @@ def test_commands_reached_the_session(api_schema: schemathesis.BaseSchema) -> No
     assert not unreached, f"only 401 or 405 answered: {unreached}"
     for path in ("laser/nudge", "drive", "mode"):
         assert _statuses[f"POST {API}/{path}"][200] > 0, dict(_statuses)
+    unfuzzed = [label for label in _statuses if not _positive_sent[label]]
+    assert not unfuzzed, f"no positive data sent to {unfuzzed}"

@@ -1,5 +1,6 @@
-"""The basket drop: a marked object ends up in the basket (judged by the simulator), and the
-postures over the basket rank by what falls where."""
+"""The basket drop: a marked object ends up in the basket (judged by the simulator), the
+postures over the basket rank by what falls where, and the live tests' judge of a drop fails
+every miss."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import math
 import numpy as np
 import pytest
 from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, isolation_robot, pick_object
+from basket import assert_in_basket
 
 from laserpick.behaviours import Behaviours, basket_opening, drop_candidates, drop_configurations
 from laserpick.bench.referee import Referee
@@ -197,3 +199,33 @@ def test_a_tall_object_is_picked_and_dropped_in_the_basket():
         assert referee.in_basket(name)
     finally:
         robot.close()
+
+
+# --- the judge of the live tests' drops (tests/basket.py) ----------------------------------------
+
+
+def _mug_record(offset: tuple[float, float], in_basket: bool) -> dict:
+    start = next(p.pos for p in load_scene("isolation").placements if p.instance == "mug_1")
+    position = [float(start[0] + offset[0]), float(start[1] + offset[1]), float(start[2])]
+    return {"name": "mug_1", "in_basket": in_basket, "position_world": position, "upright": 1.0}
+
+
+@pytest.mark.parametrize(
+    ("offset", "said"),
+    [((-0.4, 0.3), "is not in the basket"), ((0.0, 0.0), "never left the table")],
+    ids=["carried-off", "left-on-the-table"],
+)
+def test_the_drop_judge_fails_every_miss(offset: tuple[float, float], said: str) -> None:
+    """A mug outside the basket fails the live tests' pick and drop, saying where it lies:
+    an AssertionError, never an xfail or a skip (pytest's outcomes are BaseExceptions, so
+    they are caught here and made a failure)."""
+    record = _mug_record(offset, in_basket=False)
+    try:
+        assert_in_basket(record)
+    except AssertionError as exc:
+        assert said in str(exc) and str(record["position_world"]) in str(exc)
+    except BaseException as exc:  # pytest.xfail, pytest.skip
+        pytest.fail(f"a miss was reported as {type(exc).__name__}, not a failure: {exc}")
+    else:
+        pytest.fail("a mug outside the basket passed")
+    assert_in_basket(_mug_record((-0.4, 0.3), in_basket=True))

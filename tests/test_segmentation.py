@@ -6,8 +6,6 @@ object's cloud point nearest its top centre. Run with -s to see the per-object f
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -101,20 +99,6 @@ def test_grid_segmentation_iou(isolation):
         figures[name] = round(iou(_mask(seg, len(cloud)), truth), 3)
     print(f"\ngrid IoU, isolation seed {seed}: {figures}")
     assert np.median(list(figures.values())) >= 0.9, figures
-
-
-def test_segment_timing(isolation):
-    seed, _, cloud, marks = isolation
-    times = []
-    for _, mark in marks.values():
-        for _ in range(3):
-            t = time.perf_counter()
-            segment_target(cloud, mark, SETTINGS)
-            times.append(time.perf_counter() - t)
-    print(
-        f"\nsegment_target (cluster) on {len(cloud)} points, seed {seed}:"
-        f" median {1000 * np.median(times):.1f} ms"
-    )
 
 
 def test_mark_in_the_air_fails_clearly(isolation):

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import requests
 import yaml
-from basket import judge_drop, lost_in_carry
+from basket import assert_in_basket
 from serve_process import ServeProcess
 from websockets.sync.client import connect
 
@@ -116,9 +116,8 @@ def test_pick_and_drop_on_isolation(client: Client) -> None:
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     client.post("/execute")
     state = client.settled(180)
-    lost = lost_in_carry(state["failure"])
-    assert state["state"] == "idle" and (state["failure"] is None or lost), state["message"]
-    judge_drop(obj(client, "mug_1"), lost)
+    assert state["state"] == "idle" and state["failure"] is None, state["message"]
+    assert_in_basket(obj(client, "mug_1"))
     names = [e["name"] for e in client.events]
     assert "job" in names and "progress" in names
     assert client.frames > 100  # the 30 Hz stream kept coming during the task
@@ -151,14 +150,12 @@ def in_base(world: list[float], base_pose: list[float]) -> np.ndarray:
 
 
 def test_pick_and_place_on_kitchen(client: Client) -> None:
-    """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it. The
-    hand brings the point it holds to the mark (004 section 7.3), so the remote's middle
-    lands as far from the mark as the grasp was from its middle: within 3 cm of that, the
-    pick-and-place bench's tolerance."""
+    """Pick the TV remote from the 31 cm coffee table and set it down 20 cm along it: upright,
+    on the table top, the middle of its footprint (the level middle of its bounds) within
+    5 cm of the mark, as docs/testing.md promises."""
     client.post("/scene", {"yaml": kitchen_at("table_31")})
     client.post("/mode", {"mode": "pick_and_place"})
-    grasp = mark(client, "tv_remote")["current"]["position"]
-    held_off = np.subtract(obj(client, "tv_remote")["center_base"][:2], grasp[:2])
+    mark(client, "tv_remote")
     client.post("/execute")
     state = client.settled(180)
     assert state["state"] == "awaiting_place", state["message"]
@@ -171,8 +168,8 @@ def test_pick_and_place_on_kitchen(client: Client) -> None:
     placed = obj(client, "tv_remote")
     # The scooter has not moved: `base` is as at the pick.
     goal_base = in_base(goal, state["base_pose"])[:2]
-    off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base + held_off))
-    assert off < 0.03, f"{off * 100:.1f} cm from the mark plus the grasp's offset {held_off}"
+    off = np.linalg.norm(np.subtract(placed["center_base"][:2], goal_base))
+    assert off < 0.05, f"the remote's middle is {off * 100:.1f} cm from the mark"
     assert placed["upright"] > math.cos(math.radians(15))
     assert abs(placed["position_world"][2] - 0.31) < 0.02  # resting on the table top
 

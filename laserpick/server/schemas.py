@@ -138,7 +138,12 @@ class SceneRequest(_Body):
     files: dict[
         Annotated[str, Field(pattern=r"^[A-Za-z0-9_\-][A-Za-z0-9_.\-]{0,63}$")],
         Annotated[str, Field(max_length=7_000_000)],
-    ] = Field(default_factory=dict, max_length=16)
+    ] = Field(
+        default_factory=dict,
+        max_length=16,
+        # The schema states what the model enforces: a name that does not match is refused.
+        json_schema_extra={"additionalProperties": False},
+    )
     seed: int | None = Field(None, ge=0, le=2**31 - 1)
 
     @model_validator(mode="after")

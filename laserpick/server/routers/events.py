@@ -20,6 +20,9 @@ __all__ = ["router"]
 
 router = APIRouter(prefix=API)
 
+#: The answer to a message that is not a JSON text frame (binary, or text that does not parse).
+_NOT_TEXT = {"type": "error", "detail": "messages must be JSON objects, sent as text"}
+
 
 @router.websocket("/events")
 async def events(ws: WebSocket, session: SessionDep, hub: Hub) -> None:
@@ -40,8 +43,12 @@ async def events(ws: WebSocket, session: SessionDep, hub: Hub) -> None:
     sender = asyncio.create_task(_pump(ws, client))
     try:
         while True:
-            text = await ws.receive_text()
-            hub.offer(client, json.dumps(_on_message(session, client, text)))
+            message = await ws.receive()
+            if message["type"] == "websocket.disconnect":
+                break
+            text = message.get("text")
+            reply = _on_message(session, client, text) if text is not None else _NOT_TEXT
+            hub.offer(client, json.dumps(reply))
     except (WebSocketDisconnect, RuntimeError):
         pass
     finally:
@@ -62,8 +69,8 @@ def _on_message(session: Session, client: EventClient, text: str) -> dict[str, A
     """Handle one client message: a heartbeat is acknowledged, anything else refused."""
     try:
         msg = json.loads(text)
-    except ValueError:
-        return {"type": "error", "detail": "messages must be JSON objects"}
+    except (ValueError, RecursionError):  # RecursionError: nested deeper than the parser goes
+        return _NOT_TEXT
     if not isinstance(msg, dict) or msg.get("type") != "heartbeat":
         return {"type": "error", "detail": 'unknown message; send {"type": "heartbeat"}'}
     token = msg.get("token", client.token)
