@@ -100,7 +100,8 @@ def serve_usage_problem(args: argparse.Namespace, loopback: bool) -> str | None:
 
 
 class _ViewServer:
-    """The viser server, with the 3D scene view and the operator console drawn on it."""
+    """The viser server, with the 3D scene view (the simulated world as its layer) and the
+    operator console drawn on it."""
 
     def __init__(self) -> None:
         self.server: viser.ViserServer | None = None
@@ -114,12 +115,11 @@ class _ViewServer:
 
         from laserpick.console.operator_console import OperatorConsole
         from laserpick.console.viewer import SceneViewer
+        from laserpick.robot.sim.world_view import SimWorld
 
         self.server = viser.ViserServer(
             host=args.host, port=args.viser_port, label="laserpick", verbose=False
         )
-        from laserpick.robot.sim.world_view import SimWorld
-
         viewer = self.viewer = SceneViewer(
             session.robot,
             self.server,
