@@ -16,7 +16,8 @@ simulated robot's routes (`/sim/objects`, `POST /scene`) are added by
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+from collections.abc import AsyncIterator, Callable
 
 from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
@@ -25,6 +26,7 @@ from laserpick import __version__
 from laserpick.server import schemas as S
 from laserpick.server.errors import BodyLimit, add_error_handlers
 from laserpick.server.events import EventHub
+from laserpick.server.loop_lag import LoopLag
 from laserpick.server.routers import control, events, grasps, laser, motion, read, task
 from laserpick.server.routers import page as pages
 from laserpick.server.routers.dependencies import AppSettings
@@ -54,18 +56,24 @@ def create_app(
     cors_origins: allowed browser origins (default none). page: returns the HTML of `/`
     (default `static/index.html`, the operator page)."""
     limits = session.settings.server
-    hub = EventHub(session, limits.events_hz)
+    hub, lag = EventHub(session, limits.events_hz), LoopLag()
     session.on_event(hub.publish_threadsafe)
+
+    @contextlib.asynccontextmanager
+    async def lifespan(_app: FastAPI) -> AsyncIterator[None]:
+        async with hub.running(), lag.running():
+            yield
+
     app = FastAPI(
         title="laserpick",
         version=__version__,
         summary="Assistive laser-directed pick and place: the operator session's API.",
         description=_DESCRIPTION,
-        lifespan=lambda _app: hub.running(),
+        lifespan=lifespan,
         # BodyLimit refuses a body over the limit whatever the route
         responses={413: {"model": S.Problem, "description": "The body is over the size limit."}},
     )
-    app.state.session, app.state.hub = session, hub
+    app.state.session, app.state.hub, app.state.loop_lag = session, hub, lag
     app.state.settings = AppSettings(viser_port=viser_port, viser_url=viser_url, page=page)
     app.add_middleware(BodyLimit, limit=limits.max_body_bytes)
     if cors_origins:

@@ -295,3 +295,22 @@ class Health(BaseModel):
     watchdog_s: float = Field(
         description="Motion halts when the controller is silent this long (s)."
     )
+
+
+class LoopLagStats(BaseModel):
+    samples: int = Field(description="Wake-ups of the event loop's probe in the window.")
+    p50_ms: float
+    p99_ms: float
+    max_ms: float
+
+
+class Diagnostics(BaseModel):
+    """How the server process itself is doing: what the soak and the lag bench read."""
+
+    uptime_s: float
+    rss_mb: float = Field(description="The server process's resident memory (MB).")
+    rtf: float = Field(description="The robot's real-time factor (1 for hardware).")
+    loop_lag: LoopLagStats = Field(
+        description="How late the API's event loop woke (ms) over the asked window: while it"
+        " is late no socket is read, so no heartbeat arrives."
+    )

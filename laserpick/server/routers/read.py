@@ -1,12 +1,14 @@
 """Reads, which need no token: health (with the limits clients keep to), the session's state,
-the projector image, the fused cloud and the journal."""
+the projector image, the fused cloud, the journal and the server's own diagnostics."""
 
 from __future__ import annotations
 
+import resource
+import time
 from typing import Annotated, Literal
 
 import numpy as np
-from fastapi import APIRouter, HTTPException, Query
+from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.responses import PlainTextResponse, Response
 
 from laserpick import __version__
@@ -19,6 +21,8 @@ from laserpick.server.wire import CLOUD_FORMAT, encode_cloud, encode_png
 __all__ = ["router"]
 
 router = APIRouter(prefix=API, tags=["read"])
+
+_STARTED = time.monotonic()
 
 
 @router.get("/health", response_model=S.Health)
@@ -88,3 +92,28 @@ def journal(
         return PlainTextResponse(text, media_type="text/csv")
     text = j.export_json(since_id=since_id, limit=limit)
     return Response(text, media_type="application/json")
+
+
+@router.get("/diagnostics", response_model=S.Diagnostics)
+def diagnostics(
+    request: Request,
+    session: SessionDep,
+    window: Annotated[float | None, Query(gt=0, le=600, allow_inf_nan=False)] = None,
+) -> S.Diagnostics:
+    """The process's memory, the robot's real-time factor and the event loop's lag over the
+    last `window` seconds (all that is kept, up to 10 minutes, when absent)."""
+    return S.Diagnostics(
+        uptime_s=round(time.monotonic() - _STARTED, 1),
+        rss_mb=round(_rss_bytes() / 2**20, 1),
+        rtf=round(session.robot.state().rtf, 3),
+        loop_lag=S.LoopLagStats(**request.app.state.loop_lag.stats(window)),
+    )
+
+
+def _rss_bytes() -> int:
+    """Resident memory now (Linux's /proc), else the peak that `getrusage` keeps."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * resource.getpagesize()
+    except OSError:
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
