@@ -140,12 +140,6 @@ def run_adapter(args: list[str], timeout: float) -> AdapterProcess:
     return adapter
 
 
-#: The watchdog at its 2 s maximum for the whole-task runs: with the 0.5 s default, on a
-#: 2-core machine under load 5-10 the server's own event loop stalls for up to 1 s and halts
-#: picks even for a plain REST `Client`. The reconnection test keeps the default.
-PATIENT_WATCHDOG = {"LASERPICK_SERVER__WATCHDOG_S": "2.0"}
-
-
 def obj(url: str, name: str) -> dict[str, Any]:
     """The simulator's truth about the object `name` (`GET /sim/objects`)."""
     return next(o for o in Client(url).get("/sim/objects") if o["name"] == name)

@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from adapter_process import (
-    PATIENT_WATCHDOG,
     AdapterProcess,
     Script,
     aim_angles,
@@ -35,7 +34,7 @@ pytestmark = pytest.mark.timeout(400)
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServeProcess]:
-    proc = ServeProcess(tmp_path_factory.mktemp("serve"), env=PATIENT_WATCHDOG).start()
+    proc = ServeProcess(tmp_path_factory.mktemp("serve")).start()
     yield proc
     proc.close()
 

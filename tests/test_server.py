@@ -69,11 +69,13 @@ def mark(c: Client, name: str) -> dict:
 
 
 class Watcher:
-    """A read-only events client recording (wall time, sim time, max |qd|) of every frame."""
+    """A read-only events client recording (wall time, sim time, max |qd|) of every frame,
+    and (the wall time of the robot reading in the frame, max |qd|)."""
 
     def __init__(self, url: str) -> None:
         self.ws = connect("ws" + url[4:] + f"{API}/events")
         self.frames: list[tuple[float, float, float]] = []
+        self.stamped: list[tuple[float, float]] = []  #: (wall time of the reading, max |qd|)
         self._stop = threading.Event()
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
@@ -89,6 +91,7 @@ class Watcher:
             if msg.get("type") == "state":
                 qd = float(np.max(np.abs(msg["joints"]["qd"])))
                 self.frames.append((time.time(), msg["sim_time"], qd))
+                self.stamped.append((msg["read_at"], qd))
 
     def wait_moving(self, timeout: float = 60.0, speed: float = 0.05) -> None:
         end = time.monotonic() + timeout
@@ -283,6 +286,94 @@ def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) ->
         assert time.monotonic() < end, "the halted job did not wind down"
         time.sleep(0.2)
     assert "went silent" in state["failure"]["message"]
+
+
+class SilentController:
+    """A controller that heartbeats every 0.1 s, by REST (`POST /control` with its token) or
+    on the events websocket (kept open once it goes silent), until `go_silent`; `last` is
+    the wall time (s) just after its last heartbeat left."""
+
+    def __init__(self, url: str, via: str) -> None:
+        self.url, self.via = url, via
+        self.http = requests.Session()
+        grant = self.http.post(f"{url}{API}/control", json={"name": f"silent {via}"}).json()
+        self.token = grant["token"]
+        self.http.headers["Authorization"] = f"Bearer {self.token}"
+        self.ws = connect("ws" + url[4:] + f"{API}/events") if via == "websocket" else None
+        self.beating, self.last = threading.Event(), 0.0
+        self.beating.set()
+        self.thread = threading.Thread(target=self._beat, daemon=True)
+        self.thread.start()
+
+    def _beat(self) -> None:
+        while self.beating.is_set():
+            if self.ws is not None:
+                self.ws.send(json.dumps({"type": "heartbeat", "token": self.token}))
+            else:
+                self.http.post(f"{self.url}{API}/control", json={"name": f"silent {self.via}"})
+            self.last = time.time()
+            time.sleep(0.1)
+
+    def command(self, path: str, body: dict | None = None) -> None:
+        r = self.http.post(f"{self.url}{API}{path}", json=body, timeout=10)
+        assert r.ok, r.text
+
+    def state(self) -> dict:
+        return self.http.get(f"{self.url}{API}/state", timeout=10).json()
+
+    def go_silent(self) -> float:
+        """Stop heartbeating (the websocket stays open); the time of the last heartbeat."""
+        self.beating.clear()
+        self.thread.join(2.0)
+        return self.last
+
+    def close(self) -> None:
+        """Give the lease back, so that the next test may take it."""
+        self.beating.clear()
+        self.http.delete(f"{self.url}{API}/control", timeout=10)
+        if self.ws is not None:
+            self.ws.close()
+
+
+@pytest.mark.parametrize("via", ["rest", "websocket"])
+def test_a_silent_controllers_pick_halts_within_the_watchdog(
+    server: ServeProcess, via: str
+) -> None:
+    """The dead-man at its default: joint speeds under 0.01 rad/s by `watchdog_s` plus one
+    control period after the last heartbeat, the arm stays where it stopped, the failure
+    says why, and the journal has it."""
+    limits = get_settings()
+    bound = limits.server.watchdog_s + 1 / limits.sim.control_rate_hz
+    c = SilentController(server.url, via)
+    watcher = Watcher(server.url)
+    try:
+        c.command("/scene", {"name": "isolation"})
+        c.command("/laser/aim", {"point": obj(Client(server.url), "mug_1")["center_base"]})
+        c.command("/laser/confirm")
+        end = time.monotonic() + 60
+        while c.state()["state"] != "grasps_ready":
+            assert time.monotonic() < end, f"no grasps: {c.state()['message']}"
+            time.sleep(0.1)
+        c.command("/execute")
+        watcher.wait_moving()
+        last = c.go_silent()
+        time.sleep(bound + 2.0)
+    finally:
+        watcher.close()
+    frames = [(t - last, qd) for t, qd in watcher.stamped if t > last]
+    assert any(qd > 0.01 for dt, qd in frames if dt < 0.4), "not moving when it went silent"
+    late = [qd for dt, qd in frames if dt >= bound]
+    assert len(late) > 30, "the stream did not go on after the silence"
+    assert max(late) < 0.01, f"joints at {max(late):.3f} rad/s {bound:.3f} s after silence"
+    end = time.monotonic() + 60
+    while (state := c.state())["busy"]:
+        assert time.monotonic() < end, "the halted job did not wind down"
+        time.sleep(0.2)
+    assert "went silent" in state["failure"]["message"]
+    rows = c.http.get(f"{server.url}{API}/journal", params={"format": "json"}).json()
+    c.close()
+    halted = [r for r in rows if r["action"] == "watchdog" and r["outcome"] == "halted"]
+    assert halted and "went silent" in halted[-1]["message"]
 
 
 def test_heartbeats_are_acknowledged_and_strangers_refused(server: ServeProcess) -> None:

@@ -20,6 +20,7 @@ from laserpick.robot.pointer import LaserState
 from laserpick.types import DepthFrame, Projector, Trajectory
 
 __all__ = [
+    "DEADMAN_STOP",
     "PROTECTIVE_STOP",
     "GripperState",
     "JointState",
@@ -36,6 +37,9 @@ MotionStatus = Literal["running", "done", "stopped", "failed"]
 #: How a motion's message begins when the arm's controller made a protective stop (it met a
 #: force over `dims.UR5_PROTECTIVE_STOP_FORCE`), as a UR controller reports one.
 PROTECTIVE_STOP = "protective stop: "
+#: The message of a motion the controller's dead-man stopped (`Robot.deadman`), and of the
+#: motions it refuses until it is disarmed.
+DEADMAN_STOP = "dead-man: no sign of life from the operator in time; motion halted"
 
 
 class MotionHandle:
@@ -93,6 +97,7 @@ class RobotState:
     base_velocity: forward speed (m/s) and turn rate (rad/s). estopped: the e-stop is latched.
     moving: an arm motion is in progress. drive_stop: why the base last stopped itself, or "".
     rtf: robot seconds per wall second (1.0 for hardware and for a simulator keeping up).
+    read_at: wall-clock time (s since the epoch) the reading stands for.
     """
 
     stamp: float
@@ -104,6 +109,7 @@ class RobotState:
     moving: bool
     drive_stop: str
     rtf: float
+    read_at: float
 
 
 class LaserPointer(Protocol):
@@ -181,6 +187,13 @@ class Robot(Protocol):
 
     def halt(self) -> None:
         """Stop the arm and the base now, without latching (a cancelled or overdue motion)."""
+        ...
+
+    def deadman(self, until: float | None) -> None:
+        """The controller's own dead-man: once `time.monotonic()` passes `until` (s), halt the
+        arm and the base and refuse motion until this is called with None. Calls with later
+        times keep it from tripping; once tripped it stays tripped. The controller checks it
+        itself, at its own rate, so a caller that stalls stops the robot."""
         ...
 
     def stop(self) -> None:

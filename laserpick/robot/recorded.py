@@ -121,6 +121,7 @@ class RecordedRobot:
             moving=False,
             drive_stop="",
             rtf=1.0,
+            read_at=time.time(),
         )
 
     def projector(self) -> Projector:
@@ -151,6 +152,9 @@ class RecordedRobot:
 
     def halt(self) -> None:
         """Does nothing: nothing moves."""
+
+    def deadman(self, until: float | None) -> None:
+        """Does nothing: nothing moves, so there is nothing to stop."""
 
     def stop(self) -> None:
         """Latch the e-stop (reported by `state()` until `reset_stop`)."""

@@ -71,7 +71,6 @@ class EventHub:
         next_at = self.loop.time()
         while True:
             next_at += self.period
-            self.session.io_alive()
             if self.clients:
                 try:
                     status = self.session.status()

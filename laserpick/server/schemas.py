@@ -249,6 +249,9 @@ class Status(BaseModel):
     )
     sim_time: float
     rtf: float
+    read_at: float = Field(
+        description="Wall-clock time (s since the epoch) of the robot reading in this status."
+    )
     joints: JointStatus
     base_pose: list[float] = Field(description="Scooter x, y (m) and yaw (rad) in world.")
     gripper: GripperStatus

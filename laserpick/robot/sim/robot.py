@@ -118,6 +118,7 @@ class SimRobot:
             moving=s.moving,
             drive_stop=s.drive_stop,
             rtf=s.rtf,
+            read_at=s.taken_at,
         )
 
     # --- acting -----------------------------------------------------------------------------------
@@ -149,6 +150,9 @@ class SimRobot:
 
     def halt(self) -> None:
         self.sim.halt()
+
+    def deadman(self, until: float | None) -> None:
+        self.sim.deadman(until)
 
     def stop(self) -> None:
         self.sim.stop()

@@ -38,7 +38,7 @@ from laserpick.server.session.states import (
     check_transition,
 )
 from laserpick.server.session.status import grasp_summary
-from laserpick.server.session.watchdog import IO_STALL_MAX, WATCHDOG_STALL, WATCHDOG_TICK
+from laserpick.server.session.watchdog import SILENT_REASON, STALLED_REASON, WATCHDOG_TICK
 
 __all__ = [
     "AIMABLE",
@@ -47,13 +47,13 @@ __all__ = [
     "HELD_MOVED",
     "HELD_TURNED",
     "HOLDING_STATES",
-    "IO_STALL_MAX",
     "PLACED_NOT_STANDING",
     "PUT_BACK",
     "RESTING_STATES",
+    "SILENT_REASON",
+    "STALLED_REASON",
     "SYSTEM",
     "TRANSITIONS",
-    "WATCHDOG_STALL",
     "WATCHDOG_TICK",
     "Actor",
     "Capture",

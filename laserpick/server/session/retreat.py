@@ -15,10 +15,12 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
 from laserpick.pipeline.recall import moved, moved_points
 from laserpick.pipeline.surface import still_standing
+from laserpick.robot.interface import DEADMAN_STOP
 from laserpick.server.session.captures import Capture
 from laserpick.server.session.kept_views import KeptViews
 from laserpick.server.session.motion import ESTOP_REASON
 from laserpick.server.session.states import TaskState
+from laserpick.server.session.watchdog import SILENT_REASON, STALLED_REASON, WATCHDOG_TICK
 from laserpick.types import Failure
 
 #: What the user hears when a place's post-condition fails (`_placed_object_gone`).
@@ -32,6 +34,8 @@ PUT_BACK = "I found no way out holding it, so I set it back down where it was."
 #: (rad): the planner's clearance. What stood around the held object is then taken anew.
 HELD_MOVED = 0.01
 HELD_TURNED = math.radians(1.0)
+#: Why a job may end after which the arm stays where it stopped: the e-stop and the dead-man.
+_STAYS = (ESTOP_REASON, SILENT_REASON, STALLED_REASON)
 
 
 class Retreat(KeptViews):
@@ -92,12 +96,16 @@ class Retreat(KeptViews):
         hand is kept (never dropped from height): the arm tucks it in and the session holds;
         where no way to tuck it in is found, it is put back where it was picked up, if the
         arm can go back down the way it came (`Behaviours.put_back`), and the arm stows.
+        After the e-stop or the dead-man the arm stays where it stopped.
         tucked: how the tuck that failed just now went (not tried again)."""
+        if DEADMAN_STOP in failure.message:
+            self._cancel.wait(4 * WATCHDOG_TICK)  # the watchdog ends the job, saying why
         cancelled = self._cancel.is_set()
-        if self.estopped or (cancelled and self._cancel_reason == ESTOP_REASON):
-            failure = Failure("execute", ESTOP_REASON)
+        if self.estopped or (cancelled and self._cancel_reason in _STAYS):
+            # After the e-stop or the dead-man nothing moves until the operator commands it.
+            reason = ESTOP_REASON if self.estopped else self._cancel_reason
             with self._lock:
-                self._fail(failure, self._resting_state())
+                self._fail(Failure("execute", reason), self._resting_state())
             return
         if cancelled:
             failure = Failure("execute", self._cancel_reason)

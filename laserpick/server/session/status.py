@@ -100,6 +100,7 @@ class StatusReads(SessionCore):
                 drive_stop=robot.drive_stop or None,
                 sim_time=round(float(robot.stamp), 4),
                 rtf=round(float(robot.rtf), 3),
+                read_at=round(float(robot.read_at), 4),
                 joints=schemas.JointStatus(q=rounded(robot.joints.q), qd=rounded(robot.joints.qd)),
                 base_pose=rounded(robot.base_pose),
                 gripper=_gripper(robot.gripper),

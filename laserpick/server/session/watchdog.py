@@ -1,5 +1,18 @@
-"""The watchdog: halts motion commanded by a lease holder who goes silent (no heartbeat for
-`ServerSettings.watchdog_s`, or its websocket dropped), on a thread of its own.
+"""The dead-man on motion commanded through the API: silence longer than
+`ServerSettings.watchdog_s` halts the arm and the base, always.
+
+Two parts, so that neither a silent operator nor a stalled server leaves the arm moving:
+
+- the robot's controller holds a deadline (`Robot.deadman`) and halts arm and base by itself
+  when the wall clock passes it;
+- this thread, every `WATCHDOG_TICK`, sets that deadline to `watchdog_s` after the lease
+  holder's last sign of life (a heartbeat or a command; a dropped websocket is silence from
+  then), and once it has passed ends the job with the reason and journals it.
+
+The deadline is reckoned from when the holder was last heard, never from now, so a watchdog
+that runs late can only bring the halt forward: a stall of this thread, or of the event loop
+that reads the heartbeats, halts the motion too. After a halt the controller refuses motion
+until the stopped job has wound down; nothing moves again until the operator commands it.
 
 Times are `time.monotonic()` seconds.
 """
@@ -12,17 +25,22 @@ import time
 from laserpick.server.session.core import SessionCore
 from laserpick.server.session.states import SYSTEM
 
-#: The watchdog's period (s), and the gap between its ticks that means the process stalled.
-WATCHDOG_TICK, WATCHDOG_STALL = 0.02, 0.1
-#: Longest the API's event loop may lag (s) before the watchdog judges silence regardless.
-IO_STALL_MAX = 2.0
+#: The watchdog's period (s): how often it moves the controller's deadline on.
+WATCHDOG_TICK = 0.02
+#: Why a job ended when its controller was not heard from for `watchdog_s`.
+SILENT_REASON = "The controller went silent, so the motion was halted."
+#: Why a job ended when the server itself fell behind in hearing its controller.
+STALLED_REASON = (
+    "The server fell behind in hearing the controller, so the motion was halted to be safe."
+)
 
 
 class Watchdog(SessionCore):
     """The dead-man on motion commanded through the API."""
 
     def _init_watchdog(self) -> None:
-        self._io_alive: float | None = None  #: monotonic time of the API loop's last tick
+        self._deadline: float | None = None  #: the deadline the controller holds (s)
+        self._tripped = False  #: the controller halted; it stays so until the job winds down
 
     def _start_watchdog(self) -> None:
         self._closing = threading.Event()
@@ -35,43 +53,51 @@ class Watchdog(SessionCore):
         self._watchdog.join(timeout=1.0)
 
     def _watch(self) -> None:
-        """Halt motion commanded by a lease holder who has gone silent (no heartbeat for
-        `watchdog_s`, or its websocket dropped)."""
-        limit = self.settings.server.watchdog_s
-        last = time.monotonic()
         while not self._closing.wait(WATCHDOG_TICK):
-            now = time.monotonic()
-            stalled, last = now - last > WATCHDOG_STALL, now
-            if stalled:
-                # This process itself was not running (a loaded machine): heartbeats that
-                # arrived meanwhile are still queued, so silence cannot be judged this tick.
-                continue
-            io_late = now - self._io_alive if self._io_alive is not None else 0.0
-            if WATCHDOG_STALL < io_late < IO_STALL_MAX:
-                # The thread that reads the sockets is behind (starved of CPU): heartbeats
-                # may be waiting unread. A loop stuck for longer halts the motion all the same.
-                continue
-            with self._lock:
-                token = self._motion_token if self.busy else None
-                driving = time.monotonic() < self._drive_until and self._drive_token is not None
-                drive_token = self._drive_token if driving else None
-            for tok, what in ((token, "motion"), (drive_token, "drive")):
-                if tok is None or self.lease.silent_for(tok) <= limit:
-                    continue
-                self.robot.halt()
-                with self._lock:
-                    if what == "motion":
-                        self._cancel_reason = (
-                            "The controller went silent, so the motion was halted."
-                        )
-                        self._cancel.set()
-                        self._motion_token = None
-                    self._drive_until = 0.0
-                    self.message = "The controller went silent: motion halted."
-                    self._emit("watchdog", message=self.message)
-                    self._record(SYSTEM, "watchdog", "halted", message=self.message)
+            self._watch_tick(time.monotonic())
 
-    def io_alive(self) -> None:
-        """Called by the API's event loop on each of its ticks: it is reading the sockets, so
-        a missing heartbeat is the client's silence, not the server's."""
-        self._io_alive = time.monotonic()
+    def _watch_tick(self, now: float) -> None:
+        """Move the controller's deadline on to the holder's last sign of life plus
+        `watchdog_s`; once it has passed, end the motion; disarm when nothing moves."""
+        with self._lock:
+            busy = self.busy
+            motion = self._motion_token if busy else None
+            drive = self._drive_token if now < self._drive_until else None
+        if self._tripped:
+            if not busy and drive is None:  # the halted job has wound down
+                self._disarm()
+            return
+        tokens = [t for t in (motion, drive) if t is not None]
+        if not tokens:
+            if self._deadline is not None:
+                self._disarm()
+            return
+        limit = self.settings.server.watchdog_s
+        heard = min(now - self.lease.silent_for(t) for t in tokens)
+        if heard + limit <= now:
+            self._halt_motion(SILENT_REASON)
+        elif self._deadline is not None and self._deadline <= now:
+            self._halt_motion(STALLED_REASON)  # heard again, but only after the deadline
+        else:
+            self._deadline = heard + limit
+            self.robot.deadman(self._deadline)
+
+    def _disarm(self) -> None:
+        self.robot.deadman(None)
+        self._deadline, self._tripped = None, False
+
+    def _halt_motion(self, reason: str) -> None:
+        """Halt arm and base (the controller has, or does now), end the job with `reason`,
+        and keep the controller refusing motion until the job has wound down."""
+        self.robot.deadman(time.monotonic())
+        self.robot.halt()
+        self._tripped = True
+        with self._lock:
+            if self.busy:
+                self._cancel_reason = reason
+                self._cancel.set()
+                self._motion_token = None
+            self._drive_until = 0.0
+            self.message = f"{reason.split(',')[0]}: motion halted."
+            self._emit("watchdog", message=self.message)
+            self._record(SYSTEM, "watchdog", "halted", message=reason)

@@ -9,6 +9,10 @@ Commands (`execute`, `move_tcp`, `gripper`, `drive`, `stop`, ...) may come from 
 They are queued and applied by the sim thread before its next physics step, so the e-stop acts
 within one step (2 ms at 500 Hz). Nothing a command does can raise inside the loop: a command
 that fails marks its handle failed and the loop steps on.
+
+The dead-man (`deadman`) is checked by the sim thread at every physics step, against the wall
+time (`time.monotonic()`) that step stands for, so it trips within one step of its deadline
+whatever the threads that arm it are doing.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ import mujoco
 import numpy as np
 
 from laserpick.description import dims
-from laserpick.robot.interface import MotionHandle, MotionStatus
+from laserpick.robot.interface import DEADMAN_STOP, MotionHandle, MotionStatus
 from laserpick.robot.sim.arm_control import CartesianController, TrajectoryTracker
 from laserpick.robot.sim.loop.contacts import (
     Contact,
@@ -81,6 +85,10 @@ class Simulation:
         self._paused = threading.Event()
         self._snapshot_listeners: list[Callable[[Snapshot], None]] = []
         self._rtf = 0.0
+        #: The wall clock against sim time: (time.monotonic() s, data.time s) at one instant.
+        self._clock: tuple[float, float] | None = None
+        self._deadman_until: float | None = None  #: owned by the sim thread
+        self.deadman_tripped = False
         self.reset()
 
     # --- lifecycle ------------------------------------------------------------------------------
@@ -190,7 +198,7 @@ class Simulation:
         """Close (to the force limit) or open fully. Opening is allowed under e-stop."""
 
         def apply() -> None:
-            if close and self.estopped:
+            if close and (self.estopped or self.deadman_tripped):
                 return
             self._grip_closed = close
             self._grip_target = 0.0 if close else dims.GRIPPER_STROKE / 2
@@ -210,7 +218,7 @@ class Simulation:
         duration = float(np.clip(duration, 0.0, 0.5))
 
         def apply() -> None:
-            if self.estopped:
+            if self.estopped or self.deadman_tripped:
                 return
             self._drive.drive(v, w, duration)
 
@@ -219,6 +227,18 @@ class Simulation:
     def halt(self) -> None:
         """Stop arm and base motion now, without latching (cancel, watchdog)."""
         self._post(lambda: self._halt("stopped", "halted"))
+
+    def deadman(self, until: float | None) -> None:
+        """Halt arm and base once the wall clock (`time.monotonic()`, s) passes `until`, and
+        refuse motion from then until disarmed with None. Only the real-time loop has a wall
+        clock: headless, it is never due."""
+
+        def apply() -> None:
+            self._deadman_until = until
+            if until is None:
+                self.deadman_tripped = False
+
+        self._post(apply)
 
     def stop(self) -> None:
         """E-stop: halt arm and base within one step and refuse motion until `reset_stop`."""
@@ -290,19 +310,21 @@ class Simulation:
 
     def _loop(self) -> None:
         chunk_sim = _CHUNK_STEPS * self.dt
-        wall0, sim0 = time.perf_counter(), self.data.time
+        wall0, sim0 = time.monotonic(), self.data.time
         rtf_wall, rtf_sim = wall0, sim0
         while self._running.is_set():
+            self._clock = (wall0, sim0)
             if self._paused.is_set():
                 self._drain()
+                self._deadman_check()
                 time.sleep(0.01)
-                wall0, sim0 = time.perf_counter(), self.data.time
+                wall0, sim0 = time.monotonic(), self.data.time
                 continue
             with self._lock:
                 for _ in range(_CHUNK_STEPS):
                     self._step_once()
                 self._publish()
-            now = time.perf_counter()
+            now = time.monotonic()
             if now - rtf_wall >= 0.5:
                 self._rtf = (self.data.time - rtf_sim) / (now - rtf_wall)
                 rtf_wall, rtf_sim = now, self.data.time
@@ -312,6 +334,25 @@ class Simulation:
             elif lag < -10 * chunk_sim:
                 # Fell behind (a slow machine, a debugger): catch up from here, not in a burst.
                 wall0, sim0 = now, self.data.time
+
+    def _stands_for(self) -> float:
+        """The wall time (`time.monotonic()` s) the state now stands for: in real time its
+        place on the loop's clock (a chunk is computed ahead of the clock, or behind it on a
+        slow machine); headless, now."""
+        if self._clock is None:
+            return time.monotonic()
+        wall0, sim0 = self._clock
+        return wall0 + (self.data.time - sim0)
+
+    def _deadman_check(self) -> None:
+        """Trip the dead-man once this step stands for a time past its deadline, or is
+        computed after it (a loop behind the clock)."""
+        until = self._deadman_until
+        if until is None or self.deadman_tripped or self._clock is None:
+            return
+        if max(time.monotonic(), self._stands_for()) >= until:
+            self.deadman_tripped = True
+            self._halt("stopped", DEADMAN_STOP)
 
     def _drain(self) -> None:
         while True:
@@ -326,6 +367,7 @@ class Simulation:
 
     def _step_once(self) -> None:
         self._drain()
+        self._deadman_check()
         if self._steps % self._control_every == 0:
             self._control_tick()
         mujoco.mj_step(self.model, self.data)
@@ -404,6 +446,9 @@ class Simulation:
         if self.estopped:
             handle.finish("failed", "e-stop is latched; reset it first")
             return True
+        if self.deadman_tripped:
+            handle.finish("failed", DEADMAN_STOP)
+            return True
         return False
 
     # --- contacts (sim thread, or through `call`) ---------------------------------------------
@@ -438,6 +483,7 @@ class Simulation:
             moving=self._handle is not None,
             drive_stop=self._drive.stop_reason,
             rtf=self._rtf,
+            taken_at=time.time() + (self._stands_for() - time.monotonic()),
         )
         self._snap = snap
         for fn in self._snapshot_listeners:

@@ -38,6 +38,7 @@ class Snapshot:
     #: something), until it has driven freely for `drive.DRIVE_STOP_CLEARS`; "" otherwise.
     drive_stop: str
     rtf: float  #: measured real-time factor of the loop (sim seconds per wall second)
+    taken_at: float  #: wall-clock time (s since the epoch) the state stands for
 
 
 def take_snapshot(
@@ -50,10 +51,11 @@ def take_snapshot(
     moving: bool,
     drive_stop: str,
     rtf: float,
+    taken_at: float,
 ) -> Snapshot:
     """The state in `data` now, with what the loop knows beside it: the pads' force (N), the
     last gripper command, the e-stop, an arm motion in progress, the drive's stop reason and
-    the real-time factor."""
+    the real-time factor, and the wall-clock time (s since the epoch) the state stands for."""
     d = data
     width = float(d.qpos[info.finger_qpos].sum())  # each finger's travel from centre
     yaw = float(d.qpos[info.base_qpos[2]])
@@ -78,4 +80,5 @@ def take_snapshot(
         moving=moving,
         drive_stop=drive_stop,
         rtf=rtf,
+        taken_at=taken_at,
     )
