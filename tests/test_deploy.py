@@ -12,7 +12,9 @@ Through nginx, over HTTPS verified against that certificate:
    viser's websocket upgrades with its `viser-v<version>` subprotocol at `/viser` (where
    viser's client connects from a page at /viser/) and at `/viser/`, and delivers messages;
 5. `laserpick.client.Client` holds control over https, its heartbeats keeping the lease,
-   and hears every state frame.
+   and hears every state frame;
+6. headless Chromium at `/viser/` is a watcher of the 3D view, with no controls, even with
+   no password set (tests/test_view_door.py presses them with the password set).
 """
 
 from __future__ import annotations
@@ -148,3 +150,21 @@ def test_viser_websocket_through_the_proxy(stack: Stack, path: str) -> None:
             await asyncio.wait_for(ws.recv(), 30)  # and keeps talking
 
     asyncio.run(talk())
+
+
+def test_the_3d_view_through_the_proxy_only_watches(stack: Stack) -> None:
+    """Without a password too, a browser that reaches `/viser/` through nginx is no
+    operator station (nginx's forwarding headers say so): its panel has no controls."""
+    sync_api = pytest.importorskip("playwright.sync_api")
+    from laserpick.console import headless_chromium
+
+    with sync_api.sync_playwright() as p:
+        browser = headless_chromium.launch(p)
+        try:
+            page = browser.new_page(ignore_https_errors=True)
+            page.goto(stack.url + "/viser/")
+            page.get_by_text("Watching only").wait_for(timeout=60_000)
+            for label in ("Detect", "Go", "STOP", "Forward"):
+                assert page.get_by_role("button", name=label, exact=True).count() == 0
+        finally:
+            browser.close()

@@ -3,7 +3,8 @@
 1. Real websocket handshakes to a real viser server, judged by the door: straight from
    loopback without a password, the station; behind a proxy (any forwarding header), or with
    a password set, a watcher, unless the client brings a token that holds the lease (the
-   operator page's cookie); every command checks that token again.
+   operator page's cookie); every command checks that token again. In a live session, a
+   watcher's click changes nothing, not even the point the station's next click confirms.
 2. Headless Chromium through the nginx site of deploy/, with the operator password set:
    `/viser/` without the password shows no controls; pressing everything it shows and
    clicking in the scene changes nothing (state, lease, laser, mode) and moves nothing (joint
@@ -138,6 +139,51 @@ def test_a_handshake_is_direct_only_from_loopback_without_forwarding() -> None:
     assert door.judge(None) == Visitor(station=False, token=None)
     assert Handshake("::1", {"cookie": 'a="b; laserpick_lease=tok'}).lease_token is None
     assert Handshake("::1", {"cookie": "laserpick_lease="}).lease_token is None
+
+
+def test_a_watcher_s_click_leaves_the_operator_s_aim_alone(bench: DoorBench) -> None:
+    """In the view of a live session: a watcher's click on the point the station aimed at is
+    refused with the reason and changes nothing, so the station's second click there still
+    confirms the mark."""
+    import numpy as np
+
+    from laserpick.console.operator_console import OperatorConsole, to_world
+    from laserpick.robot.sim.robot import SimRobot
+    from laserpick.robot.sim.scenes import load_scene
+    from laserpick.robot.sim.truth import SimTruth
+    from laserpick.server.session import Session
+
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    console = OperatorConsole(session, bench.server)
+    said: list[str] = []
+    watcher = SimpleNamespace(client_id=7, add_notification=lambda _t, body, **_: said.append(body))
+    console.door.arrive(watcher)  # no such connection: a watcher
+    try:
+        truth = SimTruth(session.robot)
+        pts = truth.object_points(truth.instances()[0])
+        centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+        centre[2] = pts[:, 2].max() - 0.01  # on its top, as a camera above sees it
+        origin = to_world(np.array([0.2, 0.0, 1.6]), session.robot.base_pose())
+
+        def click(at_base: np.ndarray, client: object) -> None:
+            direction = to_world(at_base, session.robot.base_pose()) - origin
+            event = SimpleNamespace(ray_origin=origin, ray_direction=direction, client=client)
+            console.on_click(event)
+
+        click(centre, watcher)
+        assert session.state == TaskState.IDLE and not session.lease.info().held
+        assert said == [WATCHING]
+        click(centre, None)  # the station (in-process): aims, taking the lease as "3D view"
+        assert session.state == TaskState.AIMING and session.lease.info().holder == "3D view"
+        aimed = console.aimed_at
+        click(aimed, watcher)
+        assert said == [WATCHING, WATCHING] and console.aimed_at is aimed
+        assert session.state == TaskState.AIMING
+        click(aimed, None)
+        assert console.aimed_at is None and session.state != TaskState.AIMING
+    finally:
+        console.stop()
+        session.close()
 
 
 # --- 2. Chromium through the nginx site, with the operator password set --------------------

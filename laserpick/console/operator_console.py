@@ -145,9 +145,13 @@ class OperatorConsole:
             fn(self.actor(client))
             return True
         except (Conflict, ValueError, IndexError) as exc:
-            if client is not None:
-                client.add_notification("Not now", str(exc), color="yellow", auto_close_seconds=4.0)
+            self._refuse(client, exc)
             return False
+
+    @staticmethod
+    def _refuse(client: viser.ClientHandle | None, exc: Exception) -> None:
+        if client is not None:
+            client.add_notification("Not now", str(exc), color="yellow", auto_close_seconds=4.0)
 
     def stop_robot(self, client: viser.ClientHandle | None) -> None:
         """STOP from `client`: like the API's, it needs no lease, only the controls (a
@@ -160,8 +164,14 @@ class OperatorConsole:
         ray passes within CONFIRM_RADIUS of it) confirms the mark there (or the place mark),
         as the laser points: the session has worked that mark out since the first click.
         The confirm does not look for the ray's hit again: a capture refreshed between the
-        two clicks would put it elsewhere, and the dot is where the user clicked."""
+        two clicks would put it elsewhere, and the dot is where the user clicked. A click
+        the door refuses changes nothing, not even which point counts as aimed."""
         session = self.session
+        try:
+            self.door.actor(event.client, session.state)
+        except Conflict as exc:
+            self._refuse(event.client, exc)
+            return
         origin = np.asarray(event.ray_origin, dtype=float)
         direction = np.asarray(event.ray_direction, dtype=float)
         before = self._aimed_at if session.state in CONFIRMABLE else None
