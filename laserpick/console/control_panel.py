@@ -74,8 +74,8 @@ class ControlPanel:
     lets it in; a watcher gets a note saying why it has none (`add_watch_note`).
 
     `act(client, fn)` runs a command as the view's door allows `client`; `stop(client)`
-    latches the e-stop for a client that has the controls; `on_show_cloud(bool)` is called
-    when a client's "Show cloud" box changes (the cloud is one for every client).
+    latches the e-stop for a client that has the controls; `show_cloud(client, bool)` is
+    called when a client's "Show cloud" box changes (the cloud is one for every client).
     """
 
     def __init__(
@@ -85,10 +85,10 @@ class ControlPanel:
         act: Act,
         *,
         stop: Callable[[viser.ClientHandle | None], None],
-        on_show_cloud: Callable[[bool], None],
+        show_cloud: Callable[[viser.ClientHandle | None, bool], None],
     ) -> None:
         self.server, self.session, self._act = server, session, act
-        self._stop, self._on_show_cloud = stop, on_show_cloud
+        self._stop, self._show_cloud = stop, show_cloud
         self._lock = threading.Lock()
         #: Each client's controls by label (and "mode", "selection", "strategy", "cloud").
         self.controls: dict[int, dict[str, viser.GuiInputHandle | viser.GuiButtonHandle]] = {}
@@ -111,7 +111,7 @@ class ControlPanel:
         self._build_act(gui, handles)
         self._build_drive(gui, handles)
         show = gui.add_checkbox("Show cloud", True, order=self._order(4))
-        show.on_update(lambda _: self._on_show_cloud(bool(show.value)))
+        show.on_update(lambda e: self._show_cloud(e.client, bool(show.value)))
         handles["cloud"] = show
         with self._lock:
             self.controls[client.client_id] = handles

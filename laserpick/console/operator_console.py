@@ -77,7 +77,7 @@ class OperatorConsole:
         self.grasps = GraspOverlay(server, self.nodes)
         self.place = PlaceOverlay(server, self.nodes)
         self.panel = ControlPanel(
-            server, session, self.act, stop=self.stop_robot, on_show_cloud=self.cloud.set_visible
+            server, session, self.act, stop=self.stop_robot, show_cloud=self.show_cloud
         )
         server.on_client_connect(self._connected)
         server.on_client_disconnect(self._disconnected)
@@ -158,6 +158,11 @@ class OperatorConsole:
         watcher has none)."""
         if self.door.visitor(client).controls:
             self.session.stop(Actor(CONSOLE))
+
+    def show_cloud(self, client: viser.ClientHandle | None, show: bool) -> None:
+        """Show or hide the cloud (for every client), from a client that has the controls."""
+        if self.door.visitor(client).controls:
+            self.cloud.set_visible(show)
 
     def on_click(self, event: viser.SceneClickEvent) -> None:
         """Aim where the click's ray meets the cloud; a second click on the aimed point (its
