@@ -851,6 +851,7 @@ addEventListener("gamepadconnected", startPad);
 // --- the 3D view ----------------------------------------------------------------------------
 
 let viewUrl = null;
+let viewToken = null;  // the lease token the loaded 3D view was handed (syncViewLease)
 
 // The name of what draws WebGL here, if it is software (no GPU), else null.
 const softwareGL = (() => {
@@ -899,7 +900,6 @@ function showView(on) {
 // the view its lease token in a cookie that the view's websocket handshake carries (scoped to
 // that websocket's path; never in an address, which access logs keep), and reloads the view
 // when its token changes, so that the view acts for this page's lease.
-let viewToken = null;  // the token the loaded view was handed
 function leaseCookie(value) {
   const url = new URL(viewUrl);
   const path = url.pathname.replace(/\/+$/, "") || "/";
