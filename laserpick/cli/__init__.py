@@ -17,9 +17,10 @@ is up, and shuts down cleanly on Ctrl-C or SIGTERM.
 
 Security: it binds the loopback interface by default. Binding anything else is refused unless
 `LASERPICK_OPERATOR_PASSWORD` is set, because whoever reaches the ports can watch or command
-a robot; taking control then needs that password. The viser port has no authentication of its
-own, so on a non-loopback host the 3D view is view-only (no Pause button) and should sit
-behind the TLS proxy in deploy/.
+a robot; taking control then needs that password. The viser port has no login of its own:
+its controls act only for the operator page's control lease (the page hands the view its
+token), except for a browser on this computer connected straight to a server without a
+password; everyone else sees the scene only. Put it behind the TLS proxy in deploy/.
 
 `serve --recorded DIR` serves a recording instead (`robot.recorded.RecordedRobot`): the
 pipeline runs on the recorded frames and nothing moves; no simulator is loaded, and the 3D

@@ -109,8 +109,8 @@ class _ViewServer:
         self.console: OperatorConsole | None = None
 
     def start(self, args: argparse.Namespace, session: Session, loopback: bool) -> int:
-        """Start the server on --viser-port, the view and the console (with controls only on
-        loopback); the port it took."""
+        """Start the server on --viser-port, the view and the console (whose controls act
+        only for the clients its door lets in: `console.view_door`); the port it took."""
         import viser
 
         from laserpick.console.operator_console import OperatorConsole
@@ -125,20 +125,20 @@ class _ViewServer:
             self.server,
             world=SimWorld(session.robot.sim),  # type: ignore[attr-defined]
             rate_hz=args.viewer_rate,
-            controls=False,
             lite=args.lite_view,
         )
         viewer.start()
         session.on_scene(lambda robot: viewer.set_robot(robot, SimWorld(robot.sim)))  # type: ignore[attr-defined]
-        self.console = OperatorConsole(session, self.server, controls=loopback)
+        self.console = OperatorConsole(session, self.server)
         self.console.start()
         port = self.server.get_port()
         if port != args.viser_port and args.viser_port != 0:
             say(f"port {args.viser_port} was busy; the 3D view took {port}", err=True)
         if not loopback:
             say(
-                "the 3D view's port has no authentication of its own: it is view-only here; "
-                "put it behind the TLS proxy (deploy/)",
+                "the 3D view's port has no login of its own: its controls act only for the "
+                "operator page's lease, and anyone reaching it sees the scene; put it behind "
+                "the TLS proxy (deploy/)",
                 err=True,
             )
         return port

@@ -2,7 +2,9 @@
 
 `SceneViewer` draws the robot from its description and its reported state, and the world
 layer a simulated robot offers (`WorldLayer`); `OperatorConsole` draws the session over it
-(the fused cloud, the projector's light, the laser, the grasps) with a panel of controls.
+(the fused cloud, the projector's light, the laser, the grasps) with a panel of controls
+for the clients its door (`ViewDoor`) lets in: the API's door, so the view moves nothing for
+a browser that was never let in.
 `view_page` serves viser's client page with our script ahead of it; `headless_chromium`
 starts the browser the tests and benchmarks use.
 
@@ -19,6 +21,7 @@ __all__ = [
     "OperatorConsole",
     "RobotNodes",
     "SceneViewer",
+    "ViewDoor",
     "WorldBody",
     "WorldLayer",
     "WorldMesh",
@@ -33,6 +36,7 @@ _HOME = {
     "OperatorConsole": "operator_console",
     "RobotNodes": "robot_view",
     "SceneViewer": "viewer",
+    "ViewDoor": "view_door",
     "WorldBody": "world_layer",
     "WorldLayer": "world_layer",
     "WorldMesh": "world_layer",

@@ -1,14 +1,19 @@
 """The operator console's panel beside the 3D view: task settings, buttons, status, timings.
 
-Task (mode, selection, strategy); Act (Detect, Previous, Next, Next candidate, Go, Cancel,
-STOP, Reset stop); Drive (one `PAD_STEP` s step per click); Show cloud; the status line, the
-stage timings and why the current grasp scored as it did. Every button calls the same
-session method as the REST API, through `act`, which shows a refusal to the clicking client.
+Every client sees the status line, the stage timings and why the current grasp scored as it
+did. A client that the view's door lets in (`view_door`) also gets, on its own panel, the
+controls: Task (mode, selection, strategy); Act (Detect, Previous, Next, Next candidate, Go,
+Cancel, STOP, Reset stop); Drive (one `PAD_STEP` s step per click); Show cloud. Every control
+calls the same session method as the REST API, through `act`, which asks the door who the
+client acts as and shows a refusal to the clicking client.
 """
 
 from __future__ import annotations
 
+import functools
+import threading
 from collections.abc import Callable
+from typing import Any
 
 import viser
 
@@ -58,9 +63,20 @@ def why_this_grasp(status: dict) -> str:
     )
 
 
+def _drive(session: Session, v: float, w: float, actor: Actor) -> None:
+    """One drive pad step: `v` m/s forward, `w` rad/s left, for `PAD_STEP` s."""
+    session.drive(actor, v, w, PAD_STEP)
+
+
 class ControlPanel:
-    """The panel's GUI elements. `controls=False` shows the status only (a view-only
-    console); `on_show_cloud(bool)` is called when the "Show cloud" box changes."""
+    """The panel: texts every client sees (the status, the stage timings, why this grasp),
+    and the controls, added to one client's own panel (`add_controls`) when the view's door
+    lets it in; a watcher gets a note saying why it has none (`add_watch_note`).
+
+    `act(client, fn)` runs a command as the view's door allows `client`; `stop(client)`
+    latches the e-stop for a client that has the controls; `show_cloud(client, bool)` is
+    called when a client's "Show cloud" box changes (the cloud is one for every client).
+    """
 
     def __init__(
         self,
@@ -68,36 +84,57 @@ class ControlPanel:
         session: Session,
         act: Act,
         *,
-        controls: bool,
-        on_show_cloud: Callable[[bool], None],
+        stop: Callable[[viser.ClientHandle | None], None],
+        show_cloud: Callable[[viser.ClientHandle | None, bool], None],
     ) -> None:
         self.server, self.session, self._act = server, session, act
-        self.handles: dict[str, viser.GuiInputHandle | viser.GuiButtonHandle] = {}
+        self._stop, self._show_cloud = stop, show_cloud
+        self._lock = threading.Lock()
+        #: Each client's controls by label (and "mode", "selection", "strategy", "cloud").
+        self.controls: dict[int, dict[str, viser.GuiInputHandle | viser.GuiButtonHandle]] = {}
         gui = server.gui
         self._status = gui.add_markdown("Starting.")
-        if controls:
-            self._build_task()
-            self._build_act()
-            self._build_drive()
-        show = gui.add_checkbox("Show cloud", True)
-        show.on_update(lambda _: on_show_cloud(bool(show.value)))
-        self.handles["cloud"] = show
         with gui.add_folder("Timings (ms)"):
             self._timings = gui.add_markdown("-")
         with gui.add_folder("Why this grasp"):
             self._why = gui.add_markdown("-")
 
-    def _build_task(self) -> None:
-        gui = self.server.gui
-        with gui.add_folder("Task"):
+    def _order(self, n: int) -> float:
+        """Orders right after the status line, before the next shared element."""
+        return self._status.order + 0.01 * n
+
+    def add_controls(self, client: viser.ClientHandle) -> None:
+        """Task, Act, Drive and Show cloud on `client`'s own panel."""
+        handles: dict[str, viser.GuiInputHandle | viser.GuiButtonHandle] = {}
+        gui = client.gui
+        self._build_task(gui, handles)
+        self._build_act(gui, handles)
+        self._build_drive(gui, handles)
+        show = gui.add_checkbox("Show cloud", True, order=self._order(4))
+        show.on_update(lambda e: self._show_cloud(e.client, bool(show.value)))
+        handles["cloud"] = show
+        with self._lock:
+            self.controls[client.client_id] = handles
+
+    def add_watch_note(self, client: viser.ClientHandle, why: str) -> None:
+        """A note on `client`'s panel: it watches, and `why`."""
+        client.gui.add_markdown(f"**Watching only.** {why}", order=self._order(1))
+
+    def forget(self, client: viser.ClientHandle) -> None:
+        """`client` left: its controls went with it."""
+        with self._lock:
+            self.controls.pop(client.client_id, None)
+
+    def _build_task(self, gui: Any, handles: dict) -> None:
+        with gui.add_folder("Task", order=self._order(1)):
             for label, key, choices in TASK_CHOICES:
                 handle = gui.add_dropdown(label, choices, initial_value=getattr(self.session, key))
                 handle.on_update(self._mode_changed(handle, key))
-                self.handles[key] = handle
+                handles[key] = handle
 
-    def _build_act(self) -> None:
+    def _build_act(self, gui: Any, handles: dict) -> None:
         s = self.session
-        with self.server.gui.add_folder("Act"):
+        with gui.add_folder("Act", order=self._order(2)):
             for label, fn, colour in (
                 ("Detect", lambda a: s.confirm(a), "blue"),
                 ("Previous", lambda a: s.step_grasp(a, -1, "cluster"), None),
@@ -106,27 +143,30 @@ class ControlPanel:
                 ("Go", lambda a: s.execute(a), "green"),
                 ("Cancel", lambda a: s.cancel(a), "yellow"),
             ):
-                self._button(label, fn, colour)
-            stop = self.server.gui.add_button("STOP", color="red", icon=viser.Icon.HAND_STOP)
-            stop.on_click(lambda e: self.session.stop(Actor(CONSOLE)))
-            self.handles["STOP"] = stop
-            self._button("Reset stop", lambda a: s.reset_stop(a), None)
+                handles[label] = self._button(gui, label, fn, colour)
+            stop = gui.add_button("STOP", color="red", icon=viser.Icon.HAND_STOP)
+            stop.on_click(lambda e: self._stop(e.client))
+            handles["STOP"] = stop
+            handles["Reset stop"] = self._button(gui, "Reset stop", lambda a: s.reset_stop(a), None)
 
-    def _build_drive(self) -> None:
+    def _build_drive(self, gui: Any, handles: dict) -> None:
         s = self.session
-        with self.server.gui.add_folder(f"Drive ({PAD_STEP:g} s per click)"):
+        with gui.add_folder(f"Drive ({PAD_STEP:g} s per click)", order=self._order(3)):
             for label, v, w in (
                 ("Forward", PAD_SPEED, 0.0),
                 ("Back", -PAD_SPEED, 0.0),
                 ("Left", 0.0, PAD_TURN),
                 ("Right", 0.0, -PAD_TURN),
             ):
-                self._button(label, lambda a, v=v, w=w: s.drive(a, v, w, PAD_STEP), None)
+                drive = functools.partial(_drive, s, v, w)
+                handles[label] = self._button(gui, label, drive, None)
 
-    def _button(self, label: str, fn: Callable[[Actor], object], colour: str | None) -> None:
-        button = self.server.gui.add_button(label, color=colour)
+    def _button(
+        self, gui: Any, label: str, fn: Callable[[Actor], object], colour: str | None
+    ) -> viser.GuiButtonHandle:
+        button = gui.add_button(label, color=colour)
         button.on_click(lambda e: self._act(e.client, fn))
-        self.handles[label] = button
+        return button
 
     def _mode_changed(self, handle: viser.GuiDropdownHandle, key: str) -> Callable:
         def changed(event: viser.GuiEvent) -> None:
@@ -139,7 +179,8 @@ class ControlPanel:
         return changed
 
     def update(self, status: dict) -> None:
-        """Bring the texts and the task settings up to date with the session's status."""
+        """Bring the texts and every client's task settings up to date with the session's
+        status."""
         text = status_line(status)
         if self._status.content != text:
             self._status.content = text
@@ -150,7 +191,10 @@ class ControlPanel:
         why = why_this_grasp(status)
         if self._why.content != why:
             self._why.content = why
-        for key in ("mode", "selection", "strategy"):
-            handle = self.handles.get(key)
-            if handle is not None and handle.value != status[key]:
-                handle.value = status[key]
+        with self._lock:
+            panels = list(self.controls.values())
+        for handles in panels:
+            for key in ("mode", "selection", "strategy"):
+                handle = handles[key]
+                if handle.value != status[key]:
+                    handle.value = status[key]

@@ -9,11 +9,14 @@ the panel (`control_panel`).
 A click in the 3D view aims the laser where the click's ray meets the cloud; a second click
 near the same spot, or the Detect button, confirms the mark.
 
-Control: the page and this view are one operator station (input source "console"). The view
-acts with the lease the page holds, or takes the lease itself when it is free, heartbeats
-while a browser shows it, and lets the lease lapse (halting motion) when the last one
-disconnects. While another device (a switch adapter, a script) holds control, the view says
-who and changes nothing.
+Control goes through the view's door (`view_door`), the API's door: each browser client is
+the station, the operator or a watcher. The station (this computer's own screen, no
+password) and the page are one operator station (input source "console"): it acts with the
+lease the page holds, or takes the lease itself when it is free, heartbeats while a station
+client shows it, and lets the lease lapse (halting motion) when the last one disconnects.
+The operator acts with the lease token the operator page handed it, checked at every
+command. A watcher sees the scene and the status, and no controls. While another device (a
+switch adapter, a script) holds control, the view says who and changes nothing.
 
 Frames: the session works in `base`; the scene is drawn in `world` (z up), metres.
 """
@@ -33,6 +36,7 @@ from laserpick.console.control_panel import ControlPanel
 from laserpick.console.grasp_overlay import GraspOverlay, PlaceOverlay
 from laserpick.console.laser_overlay import LaserOverlay
 from laserpick.console.overlay import OverlayNodes, to_world
+from laserpick.console.view_door import WATCHING, ViewDoor
 from laserpick.pipeline.cloud import ray_distance
 from laserpick.server.lease import CONSOLE, LeaseHeld
 from laserpick.server.session import Actor, Conflict, Session, TaskState
@@ -53,14 +57,10 @@ REDRAW_EVENTS = ("state", "grasp", "scene", "failure", "estop", "job", "foreseen
 
 
 class OperatorConsole:
-    """The session in the 3D view, with its control panel.
+    """The session in the 3D view, with its control panel for the clients its door lets in."""
 
-    controls=False draws the session but adds no buttons and ignores clicks (a view-only
-    console, for a port other hosts can reach).
-    """
-
-    def __init__(self, session: Session, server: viser.ViserServer, *, controls: bool = True):
-        self.session, self.server, self.controls = session, server, controls
+    def __init__(self, session: Session, server: viser.ViserServer):
+        self.session, self.server = session, server
         self._lock = threading.RLock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -68,19 +68,20 @@ class OperatorConsole:
         self._aimed_at: np.ndarray | None = None  #: where the last click aimed (m, base)
         self._confirmed_at: float | None = None  #: when a click last confirmed a mark
         self._wake = threading.Event()
-        self._clients: set[int] = set()
+        self.door = ViewDoor(
+            server, session.lease, password_set=session.settings.operator_password is not None
+        )
         self.nodes = OverlayNodes()
         self.cloud = CloudOverlay(server, self.nodes)
         self.laser = LaserOverlay(server, self.nodes)
         self.grasps = GraspOverlay(server, self.nodes)
         self.place = PlaceOverlay(server, self.nodes)
+        self.panel = ControlPanel(
+            server, session, self.act, stop=self.stop_robot, show_cloud=self.show_cloud
+        )
         server.on_client_connect(self._connected)
         server.on_client_disconnect(self._disconnected)
-        self.panel = ControlPanel(
-            server, session, self.act, controls=controls, on_show_cloud=self.cloud.set_visible
-        )
-        if controls:
-            server.scene.on_click()(self.on_click)
+        server.scene.on_click()(self.on_click)
         session.on_event(self._on_event)
 
     # --- lifecycle -------------------------------------------------------------------------
@@ -103,21 +104,30 @@ class OperatorConsole:
             self._token = None
 
     def _connected(self, client: viser.ClientHandle) -> None:
-        self._clients.add(client.client_id)
+        if self.door.arrive(client).controls:
+            self.panel.add_controls(client)
+        else:
+            self.panel.add_watch_note(client, WATCHING)
 
     def _disconnected(self, client: viser.ClientHandle) -> None:
-        self._clients.discard(client.client_id)
-        if not self._clients and self._token is not None:
-            # Nobody sees the view any more: motion it commanded must stop now.
+        self.panel.forget(client)
+        self.door.leave(client)
+        if not self.door.stations() and self._token is not None:
+            # No station client sees the view any more: motion it commanded must stop now.
             self.session.lease.connection_lost(self._token)
             self._token = None
 
     # --- acting ----------------------------------------------------------------------------
 
-    def actor(self) -> Actor:
-        """Who this view acts as: the station's lease (the page's, or its own, taken when
-        free). Conflict when another device holds control."""
+    def actor(self, client: viser.ClientHandle | None = None) -> Actor:
+        """Who a command from `client` acts as (None: an in-process caller, the station).
+        The door's answer: the lease token the client brought, or, for the station, the
+        station's lease (the page's, or its own, taken when free). Conflict, saying why,
+        for a watcher, or when another device holds control."""
         lease = self.session.lease
+        actor = self.door.actor(client, self.session.state)
+        if actor is not None:
+            return actor
         if self._token is not None and lease.holds(self._token):
             return Actor(CONSOLE, self._token)
         token = lease.token_of(CONSOLE)
@@ -130,22 +140,43 @@ class OperatorConsole:
         return Actor(CONSOLE, self._token)
 
     def act(self, client: viser.ClientHandle | None, fn: Callable[[Actor], object]) -> bool:
-        """Run a session command as this view; a refusal is shown to the clicking client."""
+        """Run a session command as `client` acts (`actor`); a refusal is shown to it."""
         try:
-            fn(self.actor())
+            fn(self.actor(client))
             return True
         except (Conflict, ValueError, IndexError) as exc:
-            if client is not None:
-                client.add_notification("Not now", str(exc), color="yellow", auto_close_seconds=4.0)
+            self._refuse(client, exc)
             return False
+
+    @staticmethod
+    def _refuse(client: viser.ClientHandle | None, exc: Exception) -> None:
+        if client is not None:
+            client.add_notification("Not now", str(exc), color="yellow", auto_close_seconds=4.0)
+
+    def stop_robot(self, client: viser.ClientHandle | None) -> None:
+        """STOP from `client`: like the API's, it needs no lease, only the controls (a
+        watcher has none)."""
+        if self.door.visitor(client).controls:
+            self.session.stop(Actor(CONSOLE))
+
+    def show_cloud(self, client: viser.ClientHandle | None, show: bool) -> None:
+        """Show or hide the cloud (for every client), from a client that has the controls."""
+        if self.door.visitor(client).controls:
+            self.cloud.set_visible(show)
 
     def on_click(self, event: viser.SceneClickEvent) -> None:
         """Aim where the click's ray meets the cloud; a second click on the aimed point (its
         ray passes within CONFIRM_RADIUS of it) confirms the mark there (or the place mark),
         as the laser points: the session has worked that mark out since the first click.
         The confirm does not look for the ray's hit again: a capture refreshed between the
-        two clicks would put it elsewhere, and the dot is where the user clicked."""
+        two clicks would put it elsewhere, and the dot is where the user clicked. A click
+        the door refuses changes nothing, not even which point counts as aimed."""
         session = self.session
+        try:
+            self.door.actor(event.client, session.state)
+        except Conflict as exc:
+            self._refuse(event.client, exc)
+            return
         origin = np.asarray(event.ray_origin, dtype=float)
         direction = np.asarray(event.ray_direction, dtype=float)
         before = self._aimed_at if session.state in CONFIRMABLE else None
@@ -185,7 +216,7 @@ class OperatorConsole:
             try:
                 self.refresh()
                 now = time.monotonic()
-                if self._token is not None and self._clients and now >= next_beat:
+                if self._token is not None and self.door.stations() and now >= next_beat:
                     self.session.lease.heartbeat(self._token)
                     next_beat = now + HEARTBEAT_S
             except Exception:  # the view must never take the process down

@@ -69,9 +69,9 @@ class SceneViewer:
     `lite=True` draws for browsers without a GPU: no shadows, no environment lighting and
     flat toon shading. Headless Chromium's software WebGL (SwiftShader) then drew a frame of
     the isolation scene at 900 x 600 in about 60 ms instead of 200 ms, and every click waits
-    for the frame in progress. `controls=False` leaves out the world's Pause/Resume button (a
-    view-only console, for a port that is reachable from other hosts). The nodes are created
-    in the constructor. `update()` pushes one pose burst by hand (tests, headless stepping);
+    for the frame in progress. The viewer has no controls: those of the 3D view are the
+    operator console's, behind its door (`view_door`). The nodes are created in the
+    constructor. `update()` pushes one pose burst by hand (tests, headless stepping);
     `set_robot()` swaps in a new robot and world (a scene reset).
     """
 
@@ -83,7 +83,6 @@ class SceneViewer:
         world: WorldLayer | None = None,
         rate_hz: float = 40.0,
         set_initial_camera: bool = True,
-        controls: bool = True,
         lite: bool = False,
     ) -> None:
         if rate_hz <= 0:
@@ -92,13 +91,11 @@ class SceneViewer:
         self.rate_hz = float(rate_hz)
         self.stats = ViewerStats()
         self._set_camera = set_initial_camera
-        self._controls = controls
         self._lite = lite
         self._lock = threading.RLock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._status: viser.GuiMarkdownHandle | None = None
-        self._pause: viser.GuiButtonHandle | None = None
         self._last_status = 0.0
         self.robot, self.world = robot, world
         self.robot_nodes: RobotNodes | None = None
@@ -131,10 +128,9 @@ class SceneViewer:
         with self._lock:
             self._clear_scene()
             self._grid.remove()
-            for handle in (self._status, self._pause):
-                if handle is not None:
-                    handle.remove()
-            self._status = self._pause = None
+            if self._status is not None:
+                self._status.remove()
+            self._status = None
 
     def set_robot(self, robot: Robot, world: WorldLayer | None = None) -> None:
         """Draw a different robot and world from now on (after a scene reset): rebuilds the
@@ -207,38 +203,6 @@ class SceneViewer:
             cam.up = (0.0, 0.0, 1.0)
             cam.fov = CAMERA_FOV
         self.stats.last_stamp = state.stamp
-        self._build_pause_button()
-
-    def _build_pause_button(self) -> None:
-        """The world's Pause/Resume button, while there is a world and controls are on."""
-        if self.world is None or not self._controls:
-            if self._pause is not None:
-                self._pause.remove()
-                self._pause = None
-            return
-        if self._pause is None:
-            self._pause = self.server.gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE)
-
-            @self._pause.on_click
-            def _(_: viser.GuiEvent) -> None:
-                world = self.world
-                if world is None:
-                    return
-                if world.paused:
-                    world.resume()
-                else:
-                    world.pause()
-                self._refresh_pause_label()
-                self._update_status(force=True)
-
-        self._refresh_pause_label()
-
-    def _refresh_pause_label(self) -> None:
-        if self._pause is None or self.world is None:
-            return
-        paused = self.world.paused
-        self._pause.label = "Resume" if paused else "Pause"
-        self._pause.icon = viser.Icon.PLAYER_PLAY if paused else viser.Icon.PLAYER_PAUSE
 
     def _clear_scene(self) -> None:
         if self.robot_nodes is not None:

@@ -304,6 +304,7 @@ addEventListener("pagehide", () => {
       method: "DELETE", headers: { Authorization: `Bearer ${token}` }, keepalive: true,
     }).catch(() => {});
   }
+  if (viewUrl && viewToken) leaseCookie("");
 });
 
 // --- rendering the state (at most 10 times a second, touching only what changed) ----------
@@ -850,6 +851,7 @@ addEventListener("gamepadconnected", startPad);
 // --- the 3D view ----------------------------------------------------------------------------
 
 let viewUrl = null;
+let viewToken = null;  // the lease token the loaded 3D view was handed (syncViewLease)
 
 // The name of what draws WebGL here, if it is software (no GPU), else null.
 const softwareGL = (() => {
@@ -888,10 +890,33 @@ function showView(on) {
   // Hidden means not loaded: software WebGL would spend the robot computer's CPU for nothing.
   if (!on) frame.removeAttribute("src");
   else if (viewUrl) {
+    if (token !== viewToken) { viewToken = token; leaseCookie(token || ""); }
     const src = viewSrc();
     if (frame.getAttribute("src") !== src) frame.src = src;
   }
 }
+// The 3D view's controls act only for the operator who holds control (unless it is this
+// computer's own screen, connected straight to a server without a password): the page hands
+// the view its lease token in a cookie that the view's websocket handshake carries (scoped to
+// that websocket's path; never in an address, which access logs keep), and reloads the view
+// when its token changes, so that the view acts for this page's lease.
+function leaseCookie(value) {
+  const url = new URL(viewUrl);
+  const path = url.pathname.replace(/\/+$/, "") || "/";
+  const secure = url.protocol === "https:" || url.protocol === "wss:" ? "; Secure" : "";
+  const life = value ? "" : "; Max-Age=0";
+  document.cookie = `laserpick_lease=${value}; Path=${path}; SameSite=Strict${secure}${life}`;
+}
+function syncViewLease() {
+  if (!viewUrl || token === viewToken) return;
+  viewToken = token;
+  leaseCookie(token || "");
+  const frame = $("view");
+  if (!token || !frame.getAttribute("src")) return;
+  try { frame.contentWindow.location.reload(); } catch { frame.src = frame.getAttribute("src"); }
+}
+setInterval(syncViewLease, 150);
+
 async function findView() {
   try {
     const h = await (await fetch(`${API}/health`)).json();
