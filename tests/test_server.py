@@ -363,7 +363,7 @@ def test_a_silent_controllers_pick_halts_within_the_watchdog(
     frames = [(t - last, qd) for t, qd in watcher.stamped if t > last]
     assert any(qd > 0.01 for dt, qd in frames if dt < 0.4), "not moving when it went silent"
     late = [qd for dt, qd in frames if dt >= bound]
-    assert len(late) > 30, "the stream did not go on after the silence"
+    assert len(late) > 10, "the stream did not go on after the silence"
     assert max(late) < 0.01, f"joints at {max(late):.3f} rad/s {bound:.3f} s after silence"
     end = time.monotonic() + 60
     while (state := c.state())["busy"]:

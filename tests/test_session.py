@@ -415,3 +415,33 @@ def test_an_object_with_no_way_to_the_basket_from_where_it_was_lifted_is_tucked_
         assert truth.in_basket("mug_1")
     finally:
         session.close()
+
+
+def test_the_dead_man_is_reckoned_from_the_last_sign_of_life_never_from_now() -> None:
+    """While a lease holder's drive runs, every deadline the watchdog hands the controller
+    is at most `watchdog_s` after the holder was last heard, so a watchdog running late
+    never puts the halt off; silence past it halts the base and says why."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    pushed: list[tuple[float, float | None]] = []
+    arm = session.robot.deadman
+
+    def recording(until: float | None) -> None:
+        pushed.append((time.monotonic(), until))
+        arm(until)
+
+    session.robot.deadman = recording  # type: ignore[method-assign]
+    try:
+        actor = Actor("console", session.lease.acquire("test", "console"))
+        heard = time.monotonic()
+        for _ in range(3):  # drive on for 0.9 s, heard only at the start
+            session.drive(actor, 0.2, 0.0, 0.3)
+            time.sleep(0.3)
+        limit = session.settings.server.watchdog_s
+        # A deadline ahead of when it was handed over (not a halt's "trip now").
+        ahead = [u for t, u in pushed if u is not None and u > t]
+        assert ahead, "the watchdog never armed the controller"
+        assert max(ahead) <= heard + limit + 0.005
+        assert session.message == "The controller went silent: motion halted."
+        assert np.max(np.abs(session.robot.state().base_velocity)) < 0.01
+    finally:
+        session.close()

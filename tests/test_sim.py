@@ -217,3 +217,36 @@ def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
     assert sim.felt(pinched) == pytest.approx(0.0)
     two = [Contact(40.0, finger, 0, push), Contact(30.0, wrist, 0, np.array([30.0, 0, 0]))]
     assert sim.felt(two) == pytest.approx(70.0)
+
+
+def test_the_controllers_dead_man_halts_at_its_deadline_by_itself():
+    """Armed and never renewed, the dead-man halts a running trajectory within one physics
+    step of its deadline with nobody else acting, refuses motion while tripped, and lets
+    motion again once disarmed."""
+    s = Simulation(load_scene("isolation"), realtime=True)
+    s.start()
+    try:
+        time.sleep(0.2)
+        q0 = s.snapshot().arm_q
+        handle = s.execute(_line(q0, q0 + np.array([0.8, 0, 0, 0, 0, 0])))
+        until = time.monotonic() + 0.4
+        s.deadman(until)
+        readings = []
+        end = time.monotonic() + 1.2
+        while time.monotonic() < end:
+            snap = s.snapshot()
+            readings.append((snap.taken_at - time.time() + time.monotonic(), snap.arm_qd))
+            time.sleep(0.005)
+        assert any(np.max(np.abs(qd)) > 0.05 for t, qd in readings if t < until)
+        after = [np.max(np.abs(qd)) for t, qd in readings if t >= until + s.dt]
+        assert len(after) > 20 and max(after) < 0.01
+        assert handle.status == "stopped" and "dead-man" in handle.message
+        refused = s.execute(_line(s.snapshot().arm_q, q0))
+        time.sleep(0.1)
+        assert refused.status == "failed" and "dead-man" in refused.message
+        s.deadman(None)
+        again = s.execute(_line(s.snapshot().arm_q, q0))
+        time.sleep(0.1)
+        assert again.status in ("running", "done")
+    finally:
+        s.close()
