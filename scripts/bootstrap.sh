@@ -5,9 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# libusb: Open3D's wheel links it. EGL + Mesa: MuJoCo renders depth headless through EGL.
+# EGL + Mesa: MuJoCo renders depth headless through EGL.
 # chromium: the console's browser tests. nginx: the deploy test.
-DEB_PACKAGES=(libusb-1.0-0 libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 chromium nginx-light)
+DEB_PACKAGES=(libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 chromium nginx-light)
 
 missing=()
 for pkg in "${DEB_PACKAGES[@]}"; do

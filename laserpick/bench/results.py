@@ -30,7 +30,6 @@ RESULT_PACKAGES = (
     "mujoco",
     "numpy",
     "scipy",
-    "open3d",
     "mink",
     "qpsolvers",
     "daqp",

@@ -69,7 +69,7 @@ def euclidean_clusters(points: np.ndarray, tolerance: float) -> np.ndarray:
     next, joins them: the connected components of the radius-`tolerance` neighbour graph.
     Call it on a crop (a few thousand points): cKDTree pairs + sparse components take ~10 ms
     for 8k points, twice as fast as Open3D's cluster_dbscan(eps, min_points=1), which is the
-    same definition.
+    same definition and gives the same clusters (bench/open3d_vs_ours.py).
     """
     n = len(points)
     if n == 0:
