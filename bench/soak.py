@@ -214,6 +214,8 @@ def figures(run: dict[str, Any], ledger: Ledger, samples: Samples) -> dict[str, 
         "watchers": run["watchers"],
         "statuses": dict(sorted(ledger.statuses.items())),
     }
+    for halt in f["journal"]["watchdog_halts"]:
+        halt["controller_gaps_s"] = op.client.gaps_before(halt["t"])
     f["targets"] = targets(f)
     f["met"] = all(t["met"] for t in f["targets"].values())
     return f

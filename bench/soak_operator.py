@@ -20,10 +20,12 @@ scooter has moved from where the scene put it. Every changing request goes throu
 
 from __future__ import annotations
 
+import itertools
+import math
 import random
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
 from typing import Any
 
@@ -42,6 +44,40 @@ MAX_TRIES = 2
 SCENE = {"name": "isolation"}
 
 
+class LoggedClient(Client):
+    """A `Client` that notes (wall clock, s) when each state frame and heartbeat
+    acknowledgement arrives, and the server's time on each acknowledgement: around a
+    watchdog stop they tell a silent client (frames kept coming, so its thread ran and sent
+    heartbeats) from a server that read nothing (the acknowledgements' server times stop)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.frames_at: deque[float] = deque(maxlen=200_000)
+        self.acks: deque[tuple[float, float]] = deque(maxlen=100_000)  #: (arrived, server t)
+
+    def _on_message(self, msg: dict[str, Any]) -> None:
+        now = time.time()
+        if msg.get("type") == "state":
+            self.frames_at.append(now)
+        elif msg.get("type") == "heartbeat_ack":
+            self.acks.append((now, float(msg.get("t", math.nan))))
+        super()._on_message(msg)
+
+    def gaps_before(self, t: float, span: float = 3.0) -> dict[str, float]:
+        """The longest gaps (s) in the `span` s before wall time `t`: between state frames
+        arriving, acknowledgements arriving, and the server's times on them."""
+
+        def longest(times: list[float]) -> float:
+            near = [t - span, *sorted(x for x in times if t - span < x < t), t]
+            return round(max(b - a for a, b in itertools.pairwise(near)), 3)
+
+        return {
+            "frames_arrived": longest(list(self.frames_at)),
+            "acks_arrived": longest([a for a, _ in self.acks]),
+            "acks_server_t": longest([s for _, s in self.acks]),
+        }
+
+
 class Stopped(Exception):
     """The soak is over: the episode under way is abandoned."""
 
@@ -52,7 +88,7 @@ class Operator:
 
     def __init__(self, url: str, ledger: Ledger, stop: threading.Event, seed: int = 1) -> None:
         self.url, self.ledger, self.stop = url, ledger, stop
-        self.client = Client(url, name="soak operator", source="bench", timeout=60.0)
+        self.client = LoggedClient(url, name="soak operator", source="bench", timeout=60.0)
         self.lease_lock = threading.Lock()
         self.rng = random.Random(seed)
         self.episodes: Counter[str] = Counter()
