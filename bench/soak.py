@@ -7,9 +7,10 @@ directory (or uses the server at `--url`, whose lease must be free), and for `--
 * one controller holding the lease (`soak_operator.py`): picks, drives, cancels mid-job,
   e-stops and resets, and reconnects (drops the lease and takes it again), in turn;
 * a second client trying to take control every `--intruder-s` (it must get 409);
-* `--watchers` (default 20) read-only clients: each an events websocket and a thread polling
-  `GET /api/v1/state` at `--read-hz`;
-* a sampler reading `GET /api/v1/diagnostics` every 2 s (the real-time factor).
+* `--watchers` (default 20) read-only clients, in a process of their own
+  (`soak_watchers.py`): each an events websocket and a thread polling `GET /api/v1/state`
+  at `--read-hz`;
+* a sampler reading the real-time factor (`rtf` of `GET /api/v1/state`) every 2 s.
 
 Every minute it reads `GET /api/v1/diagnostics?window=60` (the event loop's lag over that
 minute and the server's memory) and prints a line. At the end it compares the journal
