@@ -132,11 +132,14 @@ def tick(c: Client, ledger: Ledger, samples: Samples, t0: float, window: float) 
     if d is None:
         return
     elapsed = time.monotonic() - t0
-    samples.minutes.append({"t_s": round(elapsed, 1), "rss_mb": d["rss_mb"], **d["loop_lag"]})
+    samples.minutes.append(
+        {"t_s": round(elapsed, 1), "rss_mb": d["rss_mb"], **d["loop_lag"], "gc": d["gc"]}
+    )
     recent = samples.rtf[-30:] or [float("nan")]
     print(
         f"soak {elapsed / 60:5.1f} min  rss {d['rss_mb']:6.1f} MB  "
         f"rtf {statistics.fmean(recent):.3f}  lag p99 {d['loop_lag']['p99_ms']:6.1f} ms  "
+        f"gc longest {d['gc']['longest_ms']:5.1f} ms  "
         f"sent {sum(ledger.sent.values())}  5xx {len(ledger.server_errors)}  "
         f"exceptions {sum(ledger.exceptions.values())}",
         flush=True,

@@ -26,6 +26,7 @@ from laserpick import __version__
 from laserpick.server import schemas as S
 from laserpick.server.errors import BodyLimit, add_error_handlers
 from laserpick.server.events import EventHub
+from laserpick.server.gc_pauses import GcPauses
 from laserpick.server.loop_lag import LoopLag
 from laserpick.server.routers import control, events, grasps, laser, motion, read, task
 from laserpick.server.routers import page as pages
@@ -56,13 +57,17 @@ def create_app(
     cors_origins: allowed browser origins (default none). page: returns the HTML of `/`
     (default `static/index.html`, the operator page)."""
     limits = session.settings.server
-    hub, lag = EventHub(session, limits.events_hz), LoopLag()
+    hub, lag, gc_pauses = EventHub(session, limits.events_hz), LoopLag(), GcPauses()
     session.on_event(hub.publish_threadsafe)
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: FastAPI) -> AsyncIterator[None]:
-        async with hub.running(), lag.running():
-            yield
+        gc_pauses.start()
+        try:
+            async with hub.running(), lag.running():
+                yield
+        finally:
+            gc_pauses.stop()
 
     app = FastAPI(
         title="laserpick",
@@ -73,7 +78,8 @@ def create_app(
         # BodyLimit refuses a body over the limit whatever the route
         responses={413: {"model": S.Problem, "description": "The body is over the size limit."}},
     )
-    app.state.session, app.state.hub, app.state.loop_lag = session, hub, lag
+    app.state.session, app.state.hub = session, hub
+    app.state.loop_lag, app.state.gc_pauses = lag, gc_pauses
     app.state.settings = AppSettings(viser_port=viser_port, viser_url=viser_url, page=page)
     app.add_middleware(BodyLimit, limit=limits.max_body_bytes)
     if cors_origins:

@@ -307,6 +307,12 @@ class LoopLagStats(BaseModel):
     max_ms: float
 
 
+class GcStats(BaseModel):
+    collections: int = Field(description="Garbage collections in the window.")
+    full_collections: int = Field(description="Of them, of the oldest generation.")
+    longest_ms: float = Field(description="The longest: every thread waits while one runs.")
+
+
 class Diagnostics(BaseModel):
     """How the server process itself is doing: what the soak and the lag bench read."""
 
@@ -317,3 +323,4 @@ class Diagnostics(BaseModel):
         description="How late the API's event loop woke (ms) over the asked window: while it"
         " is late no socket is read, so no heartbeat arrives."
     )
+    gc: GcStats = Field(description="Python's garbage collections over the same window.")

@@ -107,6 +107,7 @@ def diagnostics(
         rss_mb=round(_rss_bytes() / 2**20, 1),
         rtf=round(session.robot.state().rtf, 3),
         loop_lag=S.LoopLagStats(**request.app.state.loop_lag.stats(window)),
+        gc=S.GcStats(**request.app.state.gc_pauses.stats(window)),
     )
 
 
