@@ -72,8 +72,8 @@ class EventHub:
         while True:
             next_at += self.period
             if self.clients:
-                try:
-                    status = self.session.status()
+                try:  # on a thread: the session's lock may be held, and the loop reads sockets
+                    status = await asyncio.to_thread(self.session.status)
                 except Exception:
                     log.exception("status failed")
                 else:

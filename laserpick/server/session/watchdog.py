@@ -58,11 +58,12 @@ class Watchdog(SessionCore):
 
     def _watch_tick(self, now: float) -> None:
         """Move the controller's deadline on to the holder's last sign of life plus
-        `watchdog_s`; once it has passed, end the motion; disarm when nothing moves."""
-        with self._lock:
-            busy = self.busy
-            motion = self._motion_token if busy else None
-            drive = self._drive_token if now < self._drive_until else None
+        `watchdog_s`; once it has passed, end the motion; disarm when nothing moves. It reads
+        the job and the drive without the session's lock, which a command may hold while it
+        waits on the robot: a torn reading is read again a tick later."""
+        busy = self.busy
+        motion = self._motion_token if busy else None
+        drive = self._drive_token if now < self._drive_until else None
         if self._tripped:
             if not busy and drive is None:  # the halted job has wound down
                 self._disarm()
