@@ -47,11 +47,8 @@ from laserpick.pipeline.collision.arm_spheres import SPHERES, sphere_centres
 from laserpick.pipeline.collision.obstacles import obstacle_mask
 from laserpick.pipeline.gpd.frames import sample_indices
 from laserpick.pipeline.planes import (
-    height_at_centroid,
-    min_plane_inliers,
     plane_distance,
     remove_horizontal_planes,
-    surface_inliers,
 )
 from laserpick.pipeline.segment import euclidean_clusters
 from laserpick.robot.sim.truth import capture
@@ -130,27 +127,16 @@ def bench_voxels(points: np.ndarray, repeats: int, size: float = 0.01) -> None:
 
 
 def o3d_planes(cloud: FusedCloud, s: Any) -> list[SupportSurface]:
-    """remove_horizontal_planes' loop with Open3D's segment_plane finding each plane among
-    the up-facing points left; planes tilted over plane_max_tilt_deg end the loop."""
+    """`remove_horizontal_planes` with Open3D's segment_plane finding each plane among the
+    up-facing points left; a plane tilted over plane_max_tilt_deg ends the loop."""
     o3d.utility.random.seed(0)
-    pts, keep, planes = cloud.points, np.ones(len(cloud), bool), []
-    budget, need = int(s.plane_max_removed * len(pts)), min_plane_inliers(s)
-    up = cloud.normals[:, 2] >= math.cos(math.radians(s.plane_candidate_tilt_deg))
-    cand, removed = np.flatnonzero(up), 0
-    while removed + need <= budget and len(cand) >= 3:
+
+    def segment_plane(pts: np.ndarray, cand: np.ndarray) -> np.ndarray | None:
         model, _ = o3d_cloud(pts[cand]).segment_plane(s.plane_distance, 3, s.ransac_iterations)
         plane = np.asarray(model) * (1.0 if model[2] >= 0 else -1.0)
-        if plane[2] < math.cos(math.radians(s.plane_max_tilt_deg)):
-            break
-        inl = keep & (np.abs(plane_distance(pts, plane)) <= s.plane_distance)
-        count = int(np.count_nonzero(inl))
-        if surface_inliers(inl, up) < need or removed + count > budget:
-            break
-        keep &= ~inl
-        removed += count
-        cand = cand[keep[cand]]
-        planes.append(SupportSurface(height=height_at_centroid(pts, inl, plane), plane=plane))
-    return planes
+        return plane if plane[2] >= math.cos(math.radians(s.plane_max_tilt_deg)) else None
+
+    return remove_horizontal_planes(cloud, s, find_plane=segment_plane)[1]
 
 
 def bench_planes(cloud: FusedCloud, repeats: int) -> None:

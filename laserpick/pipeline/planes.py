@@ -7,6 +7,7 @@ y left, z up), metres.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -100,7 +101,10 @@ def height_at_centroid(points: np.ndarray, inliers: np.ndarray, plane: np.ndarra
 
 
 def remove_horizontal_planes(
-    cloud: FusedCloud, settings: PerceptionSettings, seed: int = 0
+    cloud: FusedCloud,
+    settings: PerceptionSettings,
+    seed: int = 0,
+    find_plane: Callable[[np.ndarray, np.ndarray], np.ndarray | None] | None = None,
 ) -> tuple[np.ndarray, list[SupportSurface]]:
     """Remove the roughly horizontal planes from the cloud, as 004 6.1 does.
 
@@ -112,9 +116,15 @@ def remove_horizontal_planes(
 
     Returns (keep mask (N,) bool: the points that are not on a removed plane, the removed
     planes as SupportSurfaces, largest first). A plane's height is its z at the centroid of its
-    inliers (m, `base`).
+    inliers (m, `base`). find_plane(points, candidate indices) -> plane or None stands in for
+    the RANSAC (`best_horizontal_plane`), for comparing another library's.
     """
     rng = np.random.default_rng(seed)
+    if find_plane is None:
+
+        def find_plane(pts: np.ndarray, cand: np.ndarray) -> np.ndarray | None:
+            return best_horizontal_plane(pts, cand, settings, rng)
+
     pts = cloud.points
     keep = np.ones(len(pts), bool)
     planes: list[SupportSurface] = []
@@ -124,7 +134,7 @@ def remove_horizontal_planes(
     cand = np.flatnonzero(up)
     removed = 0
     while removed + need <= budget and len(cand) >= 3:
-        plane = best_horizontal_plane(pts, cand, settings, rng)
+        plane = find_plane(pts, cand)
         if plane is None:
             break
         inl = keep & (np.abs(plane_distance(pts, plane)) <= settings.plane_distance)

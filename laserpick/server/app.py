@@ -24,6 +24,7 @@ from fastapi.staticfiles import StaticFiles
 
 from laserpick import __version__
 from laserpick.server import schemas as S
+from laserpick.server.background import in_background
 from laserpick.server.errors import BodyLimit, add_error_handlers
 from laserpick.server.events import EventHub
 from laserpick.server.gc_pauses import GcPauses
@@ -64,7 +65,7 @@ def create_app(
     async def lifespan(_app: FastAPI) -> AsyncIterator[None]:
         gc_pauses.start()
         try:
-            async with hub.running(), lag.running():
+            async with in_background(hub.run), in_background(lag.run):
                 yield
         finally:
             gc_pauses.stop()

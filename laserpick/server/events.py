@@ -4,11 +4,9 @@ to every websocket client, each through a short queue of its own."""
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import json
 import logging
 import time
-from collections.abc import AsyncIterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -83,14 +81,3 @@ class EventHub:
                 next_at = self.loop.time()
                 delay = 0
             await asyncio.sleep(delay)
-
-    @contextlib.asynccontextmanager
-    async def running(self) -> AsyncIterator[None]:
-        """Run the state frames while the context is open (the app's lifespan)."""
-        task = asyncio.create_task(self.run())
-        try:
-            yield
-        finally:
-            task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await task

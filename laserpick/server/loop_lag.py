@@ -8,11 +8,9 @@ Times are `loop.time()` seconds; lags are reported in ms.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import math
 import time
 from collections import deque
-from collections.abc import AsyncIterator
 
 import numpy as np
 
@@ -52,13 +50,3 @@ class LoopLag:
             "p99_ms": round(float(p99), 2),
             "max_ms": round(float(lags.max()), 2),
         }
-
-    @contextlib.asynccontextmanager
-    async def running(self) -> AsyncIterator[None]:
-        task = asyncio.create_task(self.run())
-        try:
-            yield
-        finally:
-            task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await task
