@@ -259,7 +259,9 @@ def _snapshot(server: ServeProcess) -> dict[str, Any]:
 
 def _assert_unchanged(before: dict[str, Any], after: dict[str, Any]) -> None:
     s0, s1 = before["state"], after["state"]
-    exact = [k for k in s0 if k not in ("sim_time", "rtf", "joints", "base_pose", "gripper")]
+    exact = [
+        k for k in s0 if k not in ("sim_time", "read_at", "rtf", "joints", "base_pose", "gripper")
+    ]
     assert {k: s1[k] for k in exact} == {k: s0[k] for k in exact}
     np.testing.assert_allclose(s1["joints"]["q"], s0["joints"]["q"], atol=1e-3)
     np.testing.assert_allclose(s1["base_pose"], s0["base_pose"], atol=1e-3)
