@@ -1,6 +1,7 @@
 """Driving the browser page at `/` as a person would, for the page's tests: a `laserpick
-serve` and Debian's headless Chromium for a test module, pages opened in fresh profiles,
-keys pressed toward a target, the state awaited through the API.
+serve` and Debian's headless Chromium (conftest's `page_stack` keeps one of each for all the
+page tests), pages opened in fresh profiles, keys pressed toward a target, the state awaited
+through the API.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ VIEWPORT = {"width": 1280, "height": 800}
 
 
 def serve_for_pages(tmp: Path) -> Iterator[ServeProcess]:
-    """A `laserpick serve` for a module of page tests, closed after it. No shadows: software
+    """A `laserpick serve` for the page tests, closed after them. No shadows: software
     WebGL draws twice as fast, leaving the CPU to the simulation."""
     proc = ServeProcess(tmp, extra_args=("--lite-view",))
     try:

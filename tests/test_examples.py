@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 from serve_process import REPO, ServeProcess
 
-from laserpick import cli
 from laserpick.robot.recording import read_recording
 
 pytestmark = pytest.mark.timeout(420)
@@ -55,11 +54,9 @@ def test_01_a_rest_client_fetches_an_object(tmp_path: Path):
     assert re.search(r"^idle: Dropped in the basket", out, re.MULTILINE), out
 
 
-def test_02_perceives_one_recorded_capture(tmp_path: Path):
-    recording = tmp_path / "capture"
-    args = ["record", str(recording), "--scene", "isolation", "--aim-at-object", "mug_1"]
-    assert cli.main(args) == 0
-    out = run_example("02_perceive_one_capture.py", str(recording))
+def test_02_perceives_one_recorded_capture(isolation_recording: Path):
+    # `laserpick record DIR --scene isolation --aim-at-object mug_1`, made once (conftest)
+    out = run_example("02_perceive_one_capture.py", str(isolation_recording))
     assert "(laser, seen by" in out
     assert re.search(r"^grasp 0: cluster 0, TCP at", out, re.MULTILINE), out
 

@@ -1,5 +1,5 @@
 """The browser page at `/` (laserpick/static/), in Debian's headless Chromium against a live
-`laserpick serve` started for this module.
+`laserpick serve` (conftest's `page_stack`, shared with test_page_switch_and_pad.py).
 
 1. The page loads, embeds the 3D view, and the view renders (test-artifacts/page.png); the
    mug marked by arrow keys and Detect shows lit, with its grasps (page-grasps.png). The
@@ -16,43 +16,35 @@ Switch scanning, the gamepad, Esc and driving: test_page_switch_and_pad.py.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from pathlib import Path
 from urllib.parse import parse_qs, urlsplit
 
 import pytest
 from page_driver import (
     ARTIFACTS,
     aim_by_keys,
-    chromium,
     close_page,
     finish_pick,
     fresh_scene,
     mug,
     observer,
     open_page,
-    serve_for_pages,
     tab_to,
     wait_state,
 )
 from screenshots import pixel_stats
 from serve_process import ServeProcess
 
-from laserpick.console import headless_chromium
-
-sync_api = pytest.importorskip("playwright.sync_api")
+pytest.importorskip("playwright.sync_api")
 
 
-@pytest.fixture(scope="module")
-def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServeProcess]:
-    if not Path(headless_chromium.CHROMIUM).exists():
-        pytest.skip("no Chromium at /usr/bin/chromium")
-    yield from serve_for_pages(tmp_path_factory.mktemp("page"))
+@pytest.fixture
+def server(page_stack) -> ServeProcess:
+    return page_stack.server
 
 
-@pytest.fixture(scope="module")
-def browser(server: ServeProcess) -> Iterator[object]:
-    yield from chromium(sync_api)
+@pytest.fixture
+def browser(page_stack) -> object:
+    return page_stack.browser
 
 
 @pytest.fixture
@@ -66,6 +58,7 @@ def page(browser, server: ServeProcess):
 
 
 def test_page_loads_and_the_3d_view_renders(browser, server: ServeProcess) -> None:
+    fresh_scene(server)  # idle, the mug on the table, whichever page test ran before
     page = open_page(browser, server, view=True)
     try:
         _renders(page, server)

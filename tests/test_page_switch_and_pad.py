@@ -1,5 +1,5 @@
 """The browser page at `/` with one switch and with a gamepad, in Debian's headless Chromium
-against a live `laserpick serve` started for this module.
+against a live `laserpick serve` (conftest's `page_stack`, shared with test_page.py).
 
 1. A one-switch scanning pick: the scanning settings are set and remembered across a
    reload, then the switch (Space) is pressed when the highlight reaches the wanted group or
@@ -12,43 +12,36 @@ against a live `laserpick serve` started for this module.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 from page_driver import (
     STEP,
     aim_needed,
-    chromium,
     close_page,
     finish_pick,
     fresh_scene,
     mug,
     observer,
     open_page,
-    serve_for_pages,
     tab_to,
     wait_state,
 )
 from serve_process import ServeProcess
 
 from laserpick.client import Client
-from laserpick.console import headless_chromium
 from laserpick.description import dims
 
-sync_api = pytest.importorskip("playwright.sync_api")
+pytest.importorskip("playwright.sync_api")
 
 
-@pytest.fixture(scope="module")
-def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServeProcess]:
-    if not Path(headless_chromium.CHROMIUM).exists():
-        pytest.skip("no Chromium at /usr/bin/chromium")
-    yield from serve_for_pages(tmp_path_factory.mktemp("page"))
+@pytest.fixture
+def server(page_stack) -> ServeProcess:
+    return page_stack.server
 
 
-@pytest.fixture(scope="module")
-def browser(server: ServeProcess) -> Iterator[object]:
-    yield from chromium(sync_api)
+@pytest.fixture
+def browser(page_stack) -> object:
+    return page_stack.browser
 
 
 # --- 1. a one-switch scanning pick -------------------------------------------------------

@@ -35,7 +35,8 @@ from laserpick.types import DepthFrame, Trajectory
 
 pytestmark = pytest.mark.timeout(300)
 
-TARGET = "mug_1"  #: an object of the isolation scene (its own seed) the laser is put on
+#: The isolation scene's object on which conftest's `isolation_recording` confirms the laser.
+TARGET = "mug_1"
 
 
 def _env() -> dict[str, str]:
@@ -45,12 +46,11 @@ def _env() -> dict[str, str]:
     return env
 
 
-@pytest.fixture(scope="module")
-def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """`laserpick record` of the isolation scene with the laser confirmed on TARGET."""
-    out = tmp_path_factory.mktemp("recording") / "isolation"
-    assert cli.main(["record", str(out), "--scene", "isolation", "--aim-at-object", TARGET]) == 0
-    return out
+@pytest.fixture
+def recorded(isolation_recording: Path) -> Path:
+    """`laserpick record` of the isolation scene with the laser confirmed on TARGET (made
+    once for the session; the examples read it too)."""
+    return isolation_recording
 
 
 # --- the format ------------------------------------------------------------------------------
