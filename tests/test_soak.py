@@ -1,7 +1,8 @@
 """The soak script (`bench/soak.py`) on a real `laserpick serve` for half a minute: it writes
 every figure, the server answers no request with a 5xx, the journal holds a row for every
 command that makes one, and the second client is always refused. The figures that measure
-speed (real-time factor, lag, memory growth) are the lead's long run's to judge, not this."""
+speed (real-time factor, lag, memory growth) are the long run's to judge, not this. A
+half-minute soak with its server's start is about 50 s: it runs with `make test-slow`."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
-pytestmark = pytest.mark.timeout(420)
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(420)]
 
 
 def test_a_short_soak_reports_every_figure_without_a_5xx_or_a_lost_row(tmp_path: Path) -> None:
