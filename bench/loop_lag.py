@@ -42,8 +42,8 @@ sys.path.insert(0, str(REPO / "tests"))
 
 from serve_process import ServeProcess, stop_process  # noqa: E402
 
-#: The words of the failure the dead-man reports.
-_SILENT = "went silent"
+#: How the dead-man's failures begin: the controller silent, or the server behind it.
+_DEAD_MAN = ("The controller went silent", "The server fell behind")
 
 
 def pick(url: str, index: int, timeout: float = 180.0) -> dict:
@@ -68,7 +68,7 @@ def pick(url: str, index: int, timeout: float = 180.0) -> dict:
     return {
         "seconds": seconds,
         "outcome": state["state"] if not failure else f"failed: {message[:60]}",
-        "halted": _SILENT in message,
+        "halted": message.startswith(_DEAD_MAN),
         **lag,
     }
 
