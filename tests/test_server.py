@@ -240,54 +240,6 @@ def test_cancel_halts_and_retreats(server: ServeProcess, client: Client) -> None
     assert any(e["action"] == "picking" and e["outcome"] == "cancelled" for e in journal)
 
 
-def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) -> None:
-    http = requests.Session()
-    grant = http.post(f"{server.url}{API}/control", json={"name": "flaky"}, timeout=10).json()
-    http.headers["Authorization"] = f"Bearer {grant['token']}"
-    ws = connect("ws" + server.url[4:] + f"{API}/events")
-    beating = threading.Event()
-    beating.set()
-
-    def heartbeat() -> None:
-        while beating.is_set():
-            ws.send(json.dumps({"type": "heartbeat", "token": grant["token"]}))
-            time.sleep(0.1)
-
-    threading.Thread(target=heartbeat, daemon=True).start()
-    watcher = Watcher(server.url)
-    try:
-        assert http.post(f"{server.url}{API}/scene", json={"name": "isolation"}).ok
-        objects = http.get(f"{server.url}{API}/sim/objects").json()
-        mug = next(o for o in objects if o["name"] == "mug_1")
-        assert http.post(f"{server.url}{API}/laser/aim", json={"point": mug["center_base"]}).ok
-        assert http.post(f"{server.url}{API}/laser/confirm").ok
-        end = time.monotonic() + 60
-        while http.get(f"{server.url}{API}/state").json()["state"] != "grasps_ready":
-            assert time.monotonic() < end, "no grasps"
-            time.sleep(0.1)
-        assert http.post(f"{server.url}{API}/execute").ok
-        watcher.wait_moving()
-        beating.clear()
-        dropped = time.time()
-        ws.close()
-        time.sleep(1.5)
-    finally:
-        # Whatever failed above, the heartbeats stop and the socket closes, so that the
-        # lease lapses: beating on, it held control through every later test (409s).
-        beating.clear()
-        ws.close()
-        watcher.close()
-    after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
-    assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
-    moving = [dt for dt, qd in after if qd > 0.01]
-    assert not moving or max(moving) < 0.5, f"the arm kept moving {max(moving):.2f} s after"
-    end = time.monotonic() + 60
-    while (state := http.get(f"{server.url}{API}/state").json())["busy"]:
-        assert time.monotonic() < end, "the halted job did not wind down"
-        time.sleep(0.2)
-    assert "went silent" in state["failure"]["message"]
-
-
 class SilentController:
     """A controller that heartbeats every 0.1 s, by REST (`POST /control` with its token) or
     on the events websocket (kept open once it goes silent), until `go_silent`; `last` is
@@ -321,6 +273,27 @@ class SilentController:
     def state(self) -> dict:
         return self.http.get(f"{self.url}{API}/state", timeout=10).json()
 
+    def pick_until_moving(self, name: str, watcher: Watcher) -> None:
+        """On a fresh `isolation`, mark the object `name`, wait for its grasps, Go, and
+        return once `watcher` sees the arm move."""
+        self.command("/scene", {"name": "isolation"})
+        self.command("/laser/aim", {"point": obj(Client(self.url), name)["center_base"]})
+        self.command("/laser/confirm")
+        end = time.monotonic() + 60
+        while (state := self.state())["state"] != "grasps_ready":
+            assert time.monotonic() < end, f"no grasps: {state['message']}"
+            time.sleep(0.1)
+        self.command("/execute")
+        watcher.wait_moving()
+
+    def settled(self) -> dict:
+        """The state once the halted job has wound down."""
+        end = time.monotonic() + 60
+        while (state := self.state())["busy"]:
+            assert time.monotonic() < end, "the halted job did not wind down"
+            time.sleep(0.2)
+        return state
+
     def go_silent(self) -> float:
         """Stop heartbeating (the websocket stays open); the time of the last heartbeat."""
         self.beating.clear()
@@ -335,6 +308,27 @@ class SilentController:
             self.ws.close()
 
 
+def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) -> None:
+    c = SilentController(server.url, "websocket")
+    watcher = Watcher(server.url)
+    try:
+        c.pick_until_moving("mug_1", watcher)
+        c.go_silent()
+        dropped = time.time()
+        assert c.ws is not None
+        c.ws.close()
+        time.sleep(1.5)
+    finally:
+        watcher.close()
+    after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
+    assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
+    moving = [dt for dt, qd in after if qd > 0.01]
+    assert not moving or max(moving) < 0.5, f"the arm kept moving {max(moving):.2f} s after"
+    state = c.settled()
+    c.close()
+    assert "went silent" in state["failure"]["message"]
+
+
 @pytest.mark.parametrize("via", ["rest", "websocket"])
 def test_a_silent_controllers_pick_halts_within_the_watchdog(
     server: ServeProcess, via: str
@@ -347,15 +341,7 @@ def test_a_silent_controllers_pick_halts_within_the_watchdog(
     c = SilentController(server.url, via)
     watcher = Watcher(server.url)
     try:
-        c.command("/scene", {"name": "isolation"})
-        c.command("/laser/aim", {"point": obj(Client(server.url), "mug_1")["center_base"]})
-        c.command("/laser/confirm")
-        end = time.monotonic() + 60
-        while c.state()["state"] != "grasps_ready":
-            assert time.monotonic() < end, f"no grasps: {c.state()['message']}"
-            time.sleep(0.1)
-        c.command("/execute")
-        watcher.wait_moving()
+        c.pick_until_moving("mug_1", watcher)
         last = c.go_silent()
         time.sleep(bound + 2.0)
     finally:
@@ -365,10 +351,7 @@ def test_a_silent_controllers_pick_halts_within_the_watchdog(
     late = [qd for dt, qd in frames if dt >= bound]
     assert len(late) > 10, "the stream did not go on after the silence"
     assert max(late) < 0.01, f"joints at {max(late):.3f} rad/s {bound:.3f} s after silence"
-    end = time.monotonic() + 60
-    while (state := c.state())["busy"]:
-        assert time.monotonic() < end, "the halted job did not wind down"
-        time.sleep(0.2)
+    state = c.settled()
     assert "went silent" in state["failure"]["message"]
     rows = c.http.get(f"{server.url}{API}/journal", params={"format": "json"}).json()
     c.close()
