@@ -2,7 +2,8 @@
 how much later than asked it woke. A late wake-up is time no socket was read, so no
 heartbeat could arrive: the dead-man's 0.5 s depends on it staying small.
 
-Times are `loop.time()` seconds; lags are reported in ms.
+Times are `loop.time()` seconds (asyncio's clock, `time.monotonic()`); lags are reported in
+ms.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ class LoopLag:
     `window` seconds (all that are kept when None)."""
 
     def __init__(self) -> None:
-        self._woke: deque[tuple[float, float]] = deque(maxlen=_KEPT)  #: (monotonic, lag s)
+        self._woke: deque[tuple[float, float]] = deque(maxlen=_KEPT)  #: (loop time, lag s)
 
     async def run(self) -> None:
         loop = asyncio.get_running_loop()
@@ -35,7 +36,7 @@ class LoopLag:
             asked = loop.time() + PERIOD
             await asyncio.sleep(PERIOD)
             now = loop.time()
-            self._woke.append((time.monotonic(), max(0.0, now - asked)))
+            self._woke.append((now, max(0.0, now - asked)))
 
     def stats(self, window: float | None = None) -> dict[str, float | int]:
         """How many wake-ups, and their p50, p99 and largest lag (ms)."""

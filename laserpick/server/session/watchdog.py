@@ -79,7 +79,7 @@ class Watchdog(SessionCore):
             self._halt_motion(SILENT_REASON)
         elif self._deadline is not None and self._deadline <= now:
             self._halt_motion(STALLED_REASON)  # heard again, but only after the deadline
-        else:
+        elif heard + limit != self._deadline:  # heard since the last tick: move it on
             self._deadline = heard + limit
             self.robot.deadman(self._deadline)
 
