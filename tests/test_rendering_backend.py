@@ -15,13 +15,13 @@ import numpy as np
 import pytest
 from serve_process import REPO, ServeProcess
 
-from laserpick.client import Client
+from laserpick.client import ApiError, Client
 from laserpick.robot.gl_backend import GLBackendError, pick_backend
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.truth import SimTruth
 from laserpick.server.journal import Journal
-from laserpick.server.session import Actor, Session, TaskState
+from laserpick.server.session import Actor, CamerasUnavailable, Session, TaskState
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -158,6 +158,16 @@ def test_cameras_that_cannot_render_fail_each_confirm_and_the_server_goes_on(
                 failures.append(state["failure"])
             assert all(f["kind"] == "execute" for f in failures), failures
             assert all("the cameras cannot render" in f["message"] for f in failures), failures
+            for read in (  # reads that need a new capture say why they have none
+                lambda: c.get("/cloud"),
+                lambda: c.post(
+                    "/laser/aim", {"ray": {"origin": [0, 0, 1], "direction": [1, 0, 0]}}
+                ),
+            ):
+                with pytest.raises(ApiError) as refused:
+                    read()
+                assert refused.value.status == 503, refused.value
+                assert "the cameras cannot render" in str(refused.value.detail)
             t0 = c.state()["sim_time"]
             time.sleep(0.5)
             assert c.state()["sim_time"] > t0  # the arm's controller still runs
@@ -171,6 +181,10 @@ def test_cameras_that_cannot_render_fail_each_confirm_and_the_server_goes_on(
 
 
 # --- the session ------------------------------------------------------------------------------
+
+
+#: A click's ray (origin, direction; m, `base`) from above the scooter, looking forward.
+RAY = (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))
 
 
 class CamerasUnplugged(SimRobot):
@@ -204,6 +218,9 @@ def test_a_capture_that_raises_fails_the_job_and_the_session_goes_on(tmp_path: P
         rows = [e for e in journal.events() if e["action"] == "perceiving"]
         assert [(r["outcome"], r["failure"]) for r in rows] == [("failed", "execute")]
         assert "the camera cable is unplugged" in rows[0]["message"]
+        for read in (session.cloud, lambda: session.aim_ray(actor, *RAY, "base")):
+            with pytest.raises(CamerasUnavailable, match="the camera cable is unplugged"):
+                read()
     finally:
         session.close()
         journal.close()

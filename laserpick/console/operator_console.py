@@ -39,7 +39,7 @@ from laserpick.console.overlay import OverlayNodes, to_world
 from laserpick.console.view_door import WATCHING, ViewDoor
 from laserpick.pipeline.cloud import ray_distance
 from laserpick.server.lease import CONSOLE, LeaseHeld
-from laserpick.server.session import Actor, Conflict, Session, TaskState
+from laserpick.server.session import Actor, CamerasUnavailable, Conflict, Session, TaskState
 
 __all__ = ["CONFIRM_RADIUS", "OperatorConsole", "to_world"]
 
@@ -144,7 +144,7 @@ class OperatorConsole:
         try:
             fn(self.actor(client))
             return True
-        except (Conflict, ValueError, IndexError) as exc:
+        except (Conflict, ValueError, IndexError, CamerasUnavailable) as exc:
             self._refuse(client, exc)
             return False
 

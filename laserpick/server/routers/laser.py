@@ -8,14 +8,14 @@ from fastapi import APIRouter
 
 from laserpick.server import schemas as S
 from laserpick.server.routers.dependencies import API, Commander, SessionDep
-from laserpick.server.routers.replies import CONFLICT, guarded
+from laserpick.server.routers.replies import CONFLICT, NO_FRAMES, guarded
 
 __all__ = ["router"]
 
 router = APIRouter(prefix=API, tags=["laser"], responses=CONFLICT)
 
 
-@router.post("/laser/aim", response_model=S.AimResult)
+@router.post("/laser/aim", response_model=S.AimResult, responses=NO_FRAMES)
 def aim(body: S.AimRequest, who: Commander, session: SessionDep) -> S.AimResult:
     """Aim the laser's single beam by angles, at a point, or along a click ray."""
     hit: list[float] | None = None

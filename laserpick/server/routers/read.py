@@ -16,6 +16,8 @@ from laserpick.description import dims
 from laserpick.pipeline.cloud import voxel_downsample
 from laserpick.server import schemas as S
 from laserpick.server.routers.dependencies import API, SessionDep, SettingsDep
+from laserpick.server.routers.replies import NO_FRAMES, cameras_down
+from laserpick.server.session import CamerasUnavailable
 from laserpick.server.wire import CLOUD_FORMAT, encode_cloud, encode_png
 
 __all__ = ["router"]
@@ -66,14 +68,19 @@ def projector(session: SessionDep) -> Response:
         200: {
             "content": {"application/octet-stream": {}},
             "description": f"The fused cloud, voxel-thinned: {CLOUD_FORMAT}.",
-        }
+        },
+        **NO_FRAMES,
     },
 )
 def cloud(
     session: SessionDep,
     voxel: Annotated[float | None, Query(gt=0.002, le=0.2, allow_inf_nan=False)] = None,
 ) -> Response:
-    thinned = voxel_downsample(session.cloud(), voxel or session.settings.server.cloud_voxel)
+    try:
+        fused = session.cloud()
+    except CamerasUnavailable as exc:
+        raise cameras_down(exc) from None
+    thinned = voxel_downsample(fused, voxel or session.settings.server.cloud_voxel)
     return Response(encode_cloud(thinned.points), media_type="application/octet-stream")
 
 

@@ -1,6 +1,7 @@
 """How a command is answered: `Ok` with the state after it and the robot time it was taken,
 409 when it conflicts with the task state, 422 when the session finds the input invalid; and
-the documented refusals every command route lists in the OpenAPI."""
+503 when it needed a new capture and the cameras gave none; and the documented refusals every
+command route lists in the OpenAPI."""
 
 from __future__ import annotations
 
@@ -11,9 +12,18 @@ from fastapi import HTTPException
 
 from laserpick.server import schemas as S
 from laserpick.server.errors import unprocessable
-from laserpick.server.session import Conflict, Session
+from laserpick.server.session import CamerasUnavailable, Conflict, Session
 
-__all__ = ["CONFLICT", "TOKEN_OPTIONAL", "UNAUTHORIZED", "guarded", "ok", "robot_time"]
+__all__ = [
+    "CONFLICT",
+    "NO_FRAMES",
+    "TOKEN_OPTIONAL",
+    "UNAUTHORIZED",
+    "cameras_down",
+    "guarded",
+    "ok",
+    "robot_time",
+]
 
 UNAUTHORIZED: dict[int | str, dict[str, Any]] = {
     401: {"model": S.Problem, "description": "No token, or not the lease's."}
@@ -21,6 +31,9 @@ UNAUTHORIZED: dict[int | str, dict[str, Any]] = {
 CONFLICT: dict[int | str, dict[str, Any]] = {
     **UNAUTHORIZED,
     409: {"model": S.Refusal, "description": "Conflicts with the task state."},
+}
+NO_FRAMES: dict[int | str, dict[str, Any]] = {
+    503: {"model": S.Problem, "description": "A new capture was needed; the cameras gave none."}
 }
 #: The token is optional here. FastAPI lists the bearer scheme as required and appends
 #: these requirements to it; the empty one makes the scheme optional in the OpenAPI.
@@ -39,7 +52,7 @@ def ok(session: Session, taken_at: float) -> S.Ok:
 
 def guarded(session: Session, fn: Callable[[], object]) -> S.Ok:
     """Run a session command: `Ok`, or 409 on a `Conflict`, 422 on a ValueError or
-    IndexError (input the session found invalid)."""
+    IndexError (input the session found invalid), 503 on `CamerasUnavailable`."""
     taken_at = robot_time(session)
     try:
         fn()
@@ -47,4 +60,11 @@ def guarded(session: Session, fn: Callable[[], object]) -> S.Ok:
         raise HTTPException(409, {"detail": str(exc), "state": exc.state.value}) from None
     except (ValueError, IndexError) as exc:
         raise unprocessable("body", str(exc)) from None
+    except CamerasUnavailable as exc:
+        raise cameras_down(exc) from None
     return ok(session, taken_at)
+
+
+def cameras_down(exc: CamerasUnavailable) -> HTTPException:
+    """The 503 for a read or command that needed frames the cameras could not give."""
+    return HTTPException(503, str(exc))

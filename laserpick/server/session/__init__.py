@@ -15,7 +15,7 @@ latches. The watchdog halts motion commanded by a lease holder who goes silent (
 Frames: points in `base` (m) unless a method says `world`; angles in radians.
 """
 
-from laserpick.server.session.captures import CAPTURE_MAX_AGE, Capture
+from laserpick.server.session.captures import CAPTURE_MAX_AGE, CamerasUnavailable, Capture
 from laserpick.server.session.core import Findings
 from laserpick.server.session.foresight import Foreseen
 from laserpick.server.session.motion import ESTOP_REASON
@@ -56,6 +56,7 @@ __all__ = [
     "TRANSITIONS",
     "WATCHDOG_TICK",
     "Actor",
+    "CamerasUnavailable",
     "Capture",
     "Conflict",
     "Findings",

@@ -25,6 +25,11 @@ log = logging.getLogger(__name__)
 CAPTURE_MAX_AGE = 5.0
 
 
+class CamerasUnavailable(RuntimeError):
+    """The cameras gave no frames (a driver or renderer error); the message says why. Only
+    the read that needed a new capture fails: the session and the arm go on."""
+
+
 @dataclass(frozen=True)
 class Capture:
     """One capture: the frames, their fused cloud (in `base`), the scooter's (x, y, yaw) pose
@@ -68,8 +73,11 @@ class CaptureReads(SessionCore):
         return capture
 
     def capture_now(self) -> Capture:
-        """A new capture, fused and remembered."""
-        frames = self.robot.capture()
+        """A new capture, fused and remembered. CamerasUnavailable when the cameras fail."""
+        try:
+            frames = self.robot.capture()
+        except Exception as exc:
+            raise CamerasUnavailable(f"The cameras gave no frames: {exc}") from exc
         return self._remember(frames, fuse(frames, self.settings.perception))
 
     def capture_or_none(self) -> Capture | None:
@@ -98,7 +106,8 @@ class CaptureReads(SessionCore):
             self._capture = replace(capture, at=-np.inf)
 
     def cloud(self) -> FusedCloud:
-        """A fused cloud in `base` under CAPTURE_MAX_AGE old: the last, or a new capture."""
+        """A fused cloud in `base` under CAPTURE_MAX_AGE old: the last, or a new capture
+        (CamerasUnavailable when that fails)."""
         fresh = self._fresh_capture()
         if fresh is not None:
             return fresh.cloud
@@ -108,7 +117,8 @@ class CaptureReads(SessionCore):
         self, origin: np.ndarray, direction: np.ndarray, frame: Literal["base", "world"]
     ) -> np.ndarray:
         """Where a ray (a click in the 3D view) first meets the fused cloud (m, `base`).
-        ValueError when the ray misses everything."""
+        ValueError when the ray misses everything, CamerasUnavailable when there is no fresh
+        capture and the cameras fail."""
         o = self._to_base(np.asarray(origin, dtype=float), frame)
         d = self._to_base(np.asarray(direction, dtype=float), frame, direction=True)
         hit = ray_hit(self.cloud().points, o, d, radius=self.settings.server.cloud_voxel)
