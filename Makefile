@@ -10,8 +10,8 @@ bootstrap:
 run: bootstrap
 	$(VENV)/laserpick serve
 
-test: bootstrap
-	$(VENV)/python -m pytest -q
+test: bootstrap  ## two workers, a file each at a time: most tests wait on a real-time simulation
+	$(VENV)/python -m pytest -q -n 2 --dist loadfile
 
 test-slow: bootstrap
 	$(VENV)/python -m pytest -q -m slow
