@@ -97,6 +97,7 @@ class SceneViewer:
         self._thread: threading.Thread | None = None
         self._status: viser.GuiMarkdownHandle | None = None
         self._last_status = 0.0
+        self._watched = False  #: a browser had the view open at the loop's last turn
         self.robot, self.world = robot, world
         self.robot_nodes: RobotNodes | None = None
         self.world_nodes: WorldNodes | None = None
@@ -222,13 +223,22 @@ class SceneViewer:
         if self._status is not None:
             self._status.content = self.status_text()
 
+    def _draw_if_watched(self) -> None:
+        """Update the view while a browser has it open; all of it at once when one has just
+        opened it. Drawing for nobody took about a sixth of the server's interpreter time
+        during a pick (py-spy --gil), time the event loop and the watchdog need."""
+        watched = bool(self.server.get_clients())
+        if watched:
+            self.update(force=not self._watched)
+            self._update_status(force=not self._watched)
+        self._watched = watched
+
     def _loop(self) -> None:
         period = 1.0 / self.rate_hz
         next_t = time.perf_counter()
         while not self._stop.is_set():
             try:
-                self.update()
-                self._update_status()
+                self._draw_if_watched()
             except Exception:  # the view must never take the process down
                 log.exception("viewer update failed")
             next_t += period
