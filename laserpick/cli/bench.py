@@ -1,4 +1,5 @@
-"""`laserpick bench`: the papers' experiments with the scripted operator, and `--compare`."""
+"""`laserpick bench`: the papers' experiments with the scripted operator, `--compare` and
+`--families`."""
 
 from __future__ import annotations
 
@@ -56,7 +57,37 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
         default=0.0,
         help="with --compare: how far floats may differ (absolute, m or s; default 0: exactly)",
     )
+    bench.add_argument(
+        "--families",
+        nargs="+",
+        type=Path,
+        metavar="RESULT.json",
+        help="run nothing: group the lost attempts of these result files (a sweep of seeds) by"
+        " family, with task and first-try success",
+    )
+    bench.add_argument(
+        "--leave-out",
+        action="append",
+        default=[],
+        metavar="MODEL",
+        help="with --families: also give the rates without this object model (repeatable)",
+    )
     bench.set_defaults(func=cmd_bench)
+
+
+def cmd_bench_families(paths: list[Path], leave_out: list[str]) -> int:
+    """Print the lost attempts of result files grouped by family: 0, or 2 when a file
+    cannot be read."""
+    from laserpick.bench.compare import ResultFileError
+    from laserpick.bench.families import format_sweep, load_sweep
+
+    try:
+        sweep = load_sweep(paths)
+    except ResultFileError as exc:
+        say(str(exc), err=True)
+        return EXIT_USAGE
+    print(format_sweep(sweep, leave_out), end="")
+    return 0
 
 
 def cmd_bench_compare(old: Path, new: Path, tolerance: float) -> int:
@@ -76,13 +107,18 @@ def cmd_bench_compare(old: Path, new: Path, tolerance: float) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     """Run a protocol with a progress bar; write the JSON, the report and the plots. With
     --compare, compare two result files instead."""
+    if args.families is not None:
+        if args.protocol is not None or args.compare is not None:
+            say("--families reads result files; it takes no --protocol or --compare", err=True)
+            return EXIT_USAGE
+        return cmd_bench_families(args.families, args.leave_out)
     if args.compare is not None:
         if args.protocol is not None:
             say("--compare compares two result files; it takes no --protocol", err=True)
             return EXIT_USAGE
         return cmd_bench_compare(*args.compare, args.tolerance)
     if args.protocol is None:
-        say("bench needs --protocol (or --compare OLD.json NEW.json)", err=True)
+        say("bench needs --protocol (or --compare OLD.json NEW.json, or --families)", err=True)
         return EXIT_USAGE
     return run_bench(args)
 
