@@ -214,8 +214,7 @@ class OperatorConsole:
         next_beat = 0.0
         while not self._stop.is_set():
             try:
-                if self.server.get_clients():  # nobody has the view open: nothing to draw
-                    self.refresh()
+                self.refresh()
                 now = time.monotonic()
                 if self._token is not None and self.door.stations() and now >= next_beat:
                     self.session.lease.heartbeat(self._token)

@@ -224,9 +224,11 @@ class SceneViewer:
             self._status.content = self.status_text()
 
     def _draw_if_watched(self) -> None:
-        """Update the view while a browser has it open; all of it at once when one has just
-        opened it. Drawing for nobody took about a sixth of the server's interpreter time
-        during a pick (py-spy --gil), time the event loop and the watchdog need."""
+        """Move the robot and the world while a browser has the view open; all of it at once
+        when one has just opened it. Moving them for nobody took about a seventh of the
+        server's interpreter time during a pick (py-spy --gil), time the event loop and the
+        watchdog need. (The overlays are drawn regardless, ready ahead: they cost little
+        when nothing changed.)"""
         watched = bool(self.server.get_clients())
         if watched:
             self.update(force=not self._watched)
