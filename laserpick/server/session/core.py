@@ -22,7 +22,6 @@ from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.selection import GraspCursor
 from laserpick.robot.interface import Robot
-from laserpick.server.heap import release_free_memory
 from laserpick.server.journal import Journal
 from laserpick.server.lease import ControlLease
 from laserpick.server.session.states import (
@@ -206,9 +205,6 @@ class SessionCore:
         self._job_name = name
         self._motion_token = actor.token if motion else None
         self._job = self._worker.submit(self._run_job, actor, name, job)
-        # Then what the job's arrays left free goes back to the system (`server.heap`), once
-        # the job is done: it takes the arenas' locks a few ms, and the next job waits on it.
-        self._worker.submit(release_free_memory)
 
     def _run_job(self, actor: Actor, name: str, job: Callable[[], None]) -> None:
         t0 = time.perf_counter()

@@ -6,7 +6,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from laserpick.robot.interface import Robot
-from laserpick.server.heap import release_free_memory
 from laserpick.server.session.core import SessionCore
 from laserpick.server.session.states import (
     Actor,
@@ -112,7 +111,6 @@ class TaskCommands(SessionCore):
             old.close()
             for fn in list(self._scene_listeners):
                 fn(new)
-            release_free_memory()  # the old world's, now freed: `server.heap`
             with self._lock:
                 self._emit("scene", scene=scene, message=f"Scene {scene!r} loaded.")
                 self._record(actor, "scene", "ok", message=scene)
