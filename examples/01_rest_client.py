@@ -62,9 +62,9 @@ def main() -> int:
         if args.no_go:
             return 0
         c.post("/execute")  # Go: pick, carry to the basket, drop, stow
-        state = c.wait_for(
-            lambda s: not s["busy"] and s["state"] not in ("executing", "holding"), args.timeout
-        )
+        # The job is running once the POST returns; when it ends the state says how: idle
+        # after a drop, or still holding when a halt or a failure left the object in the hand.
+        state = c.wait_for(lambda s: not s["busy"], args.timeout)
         print(f"{state['state']}: {state['message']}")
         return 0 if state["failure"] is None else 1
 

@@ -21,7 +21,7 @@ from laserpick.cli.common import (
     say,
     url_host,
 )
-from laserpick.cli.malloc_arenas import limit_malloc_arenas
+from laserpick.server.heap import fix_mmap_threshold, limit_malloc_arenas
 
 if TYPE_CHECKING:
     import viser
@@ -178,7 +178,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
         say(problem, err=True)
         return EXIT_USAGE
 
-    limit_malloc_arenas()  # before any thread: their arenas otherwise keep freed frames
+    # Before any thread and any large array: see `server.heap`.
+    limit_malloc_arenas()
+    fix_mmap_threshold()
     if args.recorded is not None:
         return serve_recording(args)
     problem = rendering_problem()

@@ -95,6 +95,7 @@ class SessionCore:
         self._cancel = threading.Event()
         self._cancel_reason = "Cancelled by the operator."  #: why `_cancel` was set
         self._motion_token: str | None = None  #: whose heartbeat the running motion needs
+        self._job_freed = threading.Event()  #: a job ended: its arrays are free to give back
 
     # --- listeners, events and the journal ----------------------------------------------------
 
@@ -218,6 +219,7 @@ class SessionCore:
                 failure = Failure("execute", f"Internal error while {name}: {exc}")
                 self._fail(failure, TaskState.IDLE)
         finally:
+            self._job_freed.set()
             with self._lock:
                 self._motion_token = None
                 task.timings[f"{name}_total"] = time.perf_counter() - t0

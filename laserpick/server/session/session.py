@@ -12,6 +12,7 @@ from laserpick.robot.interface import Robot
 from laserpick.server.journal import Journal
 from laserpick.server.session.core import Findings
 from laserpick.server.session.grasp_choice import GraspChoice
+from laserpick.server.session.heap_keeper import HeapKeeper
 from laserpick.server.session.jobs import Jobs
 from laserpick.server.session.laser_commands import LaserCommands
 from laserpick.server.session.motion import MotionCommands
@@ -23,7 +24,14 @@ from laserpick.settings import Settings, get_settings
 
 
 class Session(
-    LaserCommands, GraspChoice, TaskCommands, MotionCommands, Jobs, Watchdog, StatusReads
+    LaserCommands,
+    GraspChoice,
+    TaskCommands,
+    MotionCommands,
+    Jobs,
+    Watchdog,
+    HeapKeeper,
+    StatusReads,
 ):
     """The task state machine around one robot.
 
@@ -51,6 +59,7 @@ class Session(
         self._rng = np.random.default_rng(self.settings.server.seed)
         self._attach(robot)
         self._start_watchdog()
+        self._start_heap_keeper()
 
     def _attach(self, robot: Robot) -> None:
         """Start afresh on `robot`: no task, nothing captured, no views kept."""
@@ -89,6 +98,7 @@ class Session(
         self._close_views()
         self._close_foresight()
         self._stop_watchdog()
+        self._stop_heap_keeper()
         self.robot.close()
 
     def reseed(self, seed: int | np.random.SeedSequence) -> None:

@@ -111,6 +111,7 @@ class TaskCommands(SessionCore):
             old.close()
             for fn in list(self._scene_listeners):
                 fn(new)
+            self._job_freed.set()  # the old world's arrays are free now
             with self._lock:
                 self._emit("scene", scene=scene, message=f"Scene {scene!r} loaded.")
                 self._record(actor, "scene", "ok", message=scene)
