@@ -2,11 +2,10 @@
 
 A job's arrays (captures, clouds, grasp candidates) leave holes in glibc's arenas that stay
 resident until `server.heap.release_free_memory` gives their pages back. That call takes
-each arena's lock in turn, and the simulation's control loop allocates from the same arenas:
-run straight after a job that a halt ended, it held the loop up while the arm was still
-slowing, and the halt came a control period late. So the release waits for a moment when
-the arm, the gripper and the base are all still and no job runs; a motion commanded during
-the release starts a few milliseconds late, and nothing is moving that would need stopping.
+each arena's lock in turn, and the simulation's control loop allocates from the same
+arenas. So the release runs only while the arm, the gripper and the base are all still and
+no job runs: no halt ever waits on it. A motion commanded during the release may start as
+much later as the release takes.
 
 Times are `time.monotonic()` seconds.
 """
