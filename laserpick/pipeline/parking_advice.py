@@ -29,8 +29,8 @@ __all__ = ["ADVICE_GRASPS", "BACK_UP_STEPS", "back_up_advice", "backed_up_grasps
 #: How far back (m) the robot considers asking the user to park, nearest first: a person
 #: backs a scooter up by a hand's breadth or two, not across the room.
 BACK_UP_STEPS = (0.10, 0.20)
-#: At most this many of the grasps (evenly sampled) are tried from each step: the filter
-#: costs about a millisecond a grasp, and a step that suits any suits many.
+#: At most this many of the grasps (evenly sampled) are tried from each step, which filters
+#: them again: a step that suits any grasp suits many.
 ADVICE_GRASPS = 60
 
 
