@@ -64,10 +64,16 @@ FailureKind = Literal[
 
 @dataclass(frozen=True)
 class Failure:
-    """Why a step did not work: a typed kind and one sentence a user can read."""
+    """Why a step did not work: a typed kind and one sentence a user can read.
+
+    back_up: how far (m) the scooter should back up, straight, for the arm to do what it
+    could not from where it stands, when the robot worked that out (the sentence says so
+    too); None otherwise.
+    """
 
     kind: FailureKind
     message: str
+    back_up: float | None = None
 
     def __str__(self) -> str:
         return self.message

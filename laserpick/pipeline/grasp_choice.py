@@ -32,6 +32,7 @@ from laserpick.pipeline.collision import (
     object_middle,
 )
 from laserpick.pipeline.free_space import beyond_view
+from laserpick.pipeline.parking_advice import back_up_advice
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.pipeline.reach import reachable
@@ -164,8 +165,10 @@ def find_grasps(
     ok = [g for g in checked if g.ik is not None]
     rejected = tuple(g for g in checked if g.ik is None)
     if not ok:
-        reason = rejected[0].ik_failure
-        return Failure("ik_plan", f"The arm cannot take any of {len(checked)} grasps ({reason}).")
+        t0 = time.perf_counter()
+        back = back_up_advice(checked, world, q_ref, s.motion)
+        timings["filter"] += time.perf_counter() - t0
+        return unreachable(len(checked), rejected[0].ik_failure, back)
 
     t0 = time.perf_counter()
     mark = perception.mark.point
@@ -175,6 +178,15 @@ def find_grasps(
     return GraspSet(
         clusters, rejected, world, surroundings, target, strategy, timings, support, cut_off
     )
+
+
+def unreachable(grasps: int, reason: str | None, back: float | None) -> Failure:
+    """Why none of `grasps` grasps can be taken (`reason`, the first one's), and, where
+    backing up `back` (m) would let the arm take one, that the user should."""
+    msg = f"The arm cannot take any of {grasps} grasps ({reason})."
+    if back is not None:
+        msg += f" Back up about {round(back * 100)} cm and mark it again: from there it can."
+    return Failure("ik_plan", msg, back_up=back)
 
 
 def collision_models(

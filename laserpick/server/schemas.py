@@ -230,6 +230,9 @@ class GraspStatus(BaseModel):
 class FailureStatus(BaseModel):
     kind: str
     message: str
+    #: How far (m) to back the scooter up, straight, for the arm to do it; null when the
+    #: robot has no such advice.
+    back_up: float | None = None
 
 
 class Status(BaseModel):

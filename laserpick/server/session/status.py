@@ -115,7 +115,9 @@ class StatusReads(SessionCore):
                 timings={k: round(float(v), 4) for k, v in task.timings.items()},
                 failure=None
                 if failure is None
-                else schemas.FailureStatus(kind=failure.kind, message=failure.message),
+                else schemas.FailureStatus(
+                    kind=failure.kind, message=failure.message, back_up=failure.back_up
+                ),
                 lease=schemas.LeaseStatus(
                     held=lease.held, holder=lease.holder, source=lease.source
                 ),

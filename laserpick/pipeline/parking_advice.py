@@ -1,0 +1,69 @@
+"""How far the scooter should back up for the arm to take a grasp it cannot take from here.
+
+At a bookshelf parked close, the forearm comes down onto the board above the object for
+every posture of every grasp; 10 cm farther back it comes in level. When the reachability
+filter leaves no grasp, the same grasps are tried as they would lie after backing up
+straight by each of BACK_UP_STEPS: the grasps and the seen cloud move forward by that much
+in `base` (the scooter and its rider, which the checker models in `base`, stay). The first
+step from which some grasp has a collision-free posture is what the robot asks for. Only
+postures are checked, against what the cameras saw from here; the view from there decides
+the grasps after the drive.
+
+Frames: `base` (x forward, the scooter's heading), metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.reach import reachable
+from laserpick.settings import MotionSettings
+from laserpick.types import Grasp
+
+__all__ = ["ADVICE_GRASPS", "BACK_UP_STEPS", "back_up_advice", "backed_up_grasps"]
+
+#: How far back (m) the robot considers asking the user to park, nearest first: a person
+#: backs a scooter up by a hand's breadth or two, not across the room.
+BACK_UP_STEPS = (0.10, 0.20)
+#: At most this many of the grasps (evenly sampled) are tried from each step: the filter
+#: costs about a millisecond a grasp, and a step that suits any suits many.
+ADVICE_GRASPS = 60
+
+
+def backed_up_grasps(grasps: Sequence[Grasp], back: float) -> list[Grasp]:
+    """`grasps` as they lie after the scooter backs up `back` (m): `back` farther forward in
+    `base`, with no posture chosen yet."""
+    out = []
+    for g in grasps:
+        pose = g.pose.copy()
+        pose[0, 3] += back
+        out.append(replace(g, pose=pose, ik=None, ik_failure=None))
+    return out
+
+
+def back_up_advice(
+    grasps: Sequence[Grasp],
+    world: CollisionChecker,
+    q_ref: np.ndarray,
+    motion: MotionSettings,
+    steps: Sequence[float] = BACK_UP_STEPS,
+) -> float | None:
+    """The least of `steps` (m) the scooter should back up for the arm to take one of
+    `grasps` (from the filter, none reachable here) without touching what `world` holds, as
+    the reachability filter judges from q_ref (6,) rad; None when no step serves."""
+    if not grasps:
+        return None
+    sample = list(grasps[:: max(1, -(-len(grasps) // ADVICE_GRASPS))])
+    for back in steps:
+        there = CollisionChecker(
+            world.points + np.array([back, 0.0, 0.0]), margin=world.margin, filtered=True
+        )
+        moved = backed_up_grasps(sample, back)
+        found = reachable(moved, there, q_ref, motion.approach_distance, motion.lift_least)
+        if any(g.ik is not None for g in found):
+            return back
+    return None

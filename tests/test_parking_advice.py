@@ -1,0 +1,83 @@
+"""The robot's advice to back up (`laserpick.pipeline.parking_advice`): the least step back
+from which the arm can take a grasp it cannot take from here, or none."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from laserpick.description.dims import ARM_MOUNT_POS, UR5_READY_Q
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.grasp_choice import unreachable
+from laserpick.pipeline.parking_advice import BACK_UP_STEPS, back_up_advice, backed_up_grasps
+from laserpick.pipeline.reach import reachable
+from laserpick.settings import get_settings
+from laserpick.types import Grasp
+
+MOTION = get_settings().motion
+NOTHING = CollisionChecker(np.zeros((0, 3)))
+
+
+def level_grasp(x: float) -> Grasp:
+    """A grasp x m ahead of the arm's mount, 20 cm above it, the hand level and pointing
+    forward (approach +x), the fingers closing across (y)."""
+    pose = np.eye(4)
+    pose[:3, :3] = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+    pose[:3, 3] = ARM_MOUNT_POS + np.array([x, 0.0, 0.2])
+    return Grasp(pose=pose, width=0.05)
+
+
+def takes(grasp: Grasp) -> bool:
+    found = reachable([grasp], NOTHING, UR5_READY_Q, MOTION.approach_distance, MOTION.lift_least)
+    return found[0].ik is not None
+
+
+def nearest_taken() -> float:
+    """The nearest x (m, in 1 cm steps) ahead of the mount at which the arm takes the level
+    grasp: nearer, it cannot fold back far enough."""
+    for x in np.arange(0.0, 0.8, 0.01):
+        if takes(level_grasp(float(x))):
+            return float(x)
+    raise AssertionError("the arm takes no level grasp within 80 cm of its mount")
+
+
+def test_backing_up_moves_the_grasps_forward_in_base_and_forgets_their_postures() -> None:
+    g = level_grasp(0.4)
+    (moved,) = backed_up_grasps([g], 0.1)
+    assert np.allclose(moved.pose[:3, 3], g.pose[:3, 3] + [0.1, 0.0, 0.0])
+    assert np.allclose(moved.pose[:3, :3], g.pose[:3, :3])
+    assert moved.ik is None and moved.ik_failure is None
+
+
+def test_the_least_step_back_that_lets_the_arm_take_a_grasp_too_near_it() -> None:
+    x = nearest_taken()
+    assert not takes(level_grasp(x - 0.01))
+    too_near = [level_grasp(x - BACK_UP_STEPS[0] + 0.005)]
+    assert back_up_advice(too_near, NOTHING, UR5_READY_Q, MOTION) == BACK_UP_STEPS[0]
+    nearer = [level_grasp(x - BACK_UP_STEPS[1] + 0.005)]
+    assert not takes(nearer[0])
+    assert back_up_advice(nearer, NOTHING, UR5_READY_Q, MOTION) == BACK_UP_STEPS[1]
+
+
+def test_no_advice_where_backing_up_does_not_help() -> None:
+    assert back_up_advice([level_grasp(2.5)], NOTHING, UR5_READY_Q, MOTION) is None
+    assert back_up_advice([], NOTHING, UR5_READY_Q, MOTION) is None
+
+
+def test_what_the_cameras_saw_moves_with_the_grasps() -> None:
+    """The object's own points, seen where it stands now, move forward with its grasp: after
+    the step they lie ahead of the hand's pre-grasp, not where the hand comes in. Left where
+    they were, they would stand right at the pre-grasp, and no step would serve."""
+    x = nearest_taken()
+    near = level_grasp(x - BACK_UP_STEPS[0] + 0.005)
+    rng = np.random.default_rng(0)
+    blob = near.pose[:3, 3] + rng.uniform(-0.02, 0.02, (200, 3))
+    world = CollisionChecker(blob, margin=MOTION.clearance)
+    assert back_up_advice([near], world, UR5_READY_Q, MOTION) == BACK_UP_STEPS[0]
+
+
+def test_the_sentence_and_the_failure_carry_the_advice() -> None:
+    failure = unreachable(12, "every arm posture for this grasp collides with something", 0.1)
+    assert failure.kind == "ik_plan" and failure.back_up == 0.1
+    assert "Back up about 10 cm and mark it again" in failure.message
+    plain = unreachable(12, "the arm cannot reach this grasp", None)
+    assert plain.back_up is None and "Back up" not in plain.message
