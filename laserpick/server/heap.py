@@ -1,5 +1,5 @@
 """How glibc's malloc keeps the server's heap (Linux): few arenas, large blocks mapped apart,
-and what a job freed given back to the system when it ends.
+and what the jobs freed given back to the system (the session's heap keeper says when).
 
 The server's threads allocate the numpy arrays of captures, clouds and grasp candidates by
 the hundred megabytes a job, and free them when it ends. glibc keeps what was freed:
@@ -82,7 +82,7 @@ def fix_mmap_threshold(threshold: int = MMAP_THRESHOLD) -> bool:
 
 def release_free_memory() -> bool:
     """Give the pages of every arena's free blocks back to the system (glibc's `malloc_trim`):
-    after a job, what its arrays left free. Takes each arena's lock for a few milliseconds.
-    Whether any memory was given back (False off glibc)."""
+    after a job, what its arrays left free. Takes each arena's lock in turn. Whether any
+    memory was given back (False off glibc)."""
     libc = _glibc()
     return libc is not None and bool(libc.malloc_trim(0))

@@ -3,9 +3,9 @@
 A job's arrays (captures, clouds, grasp candidates) leave holes in glibc's arenas that stay
 resident until `server.heap.release_free_memory` gives their pages back. That call takes
 each arena's lock in turn, and the simulation's control loop allocates from the same
-arenas. So the release runs only while no job runs (jobs alone move the gripper) and the arm
-and the base are still: no halt ever waits on it. A motion commanded during the release may start as
-much later as the release takes.
+arenas. So the release runs only while no job runs (jobs alone move the gripper) and the
+arm and the base are still: no halt ever waits on it. A motion commanded during the release
+may start as much later as the release takes.
 
 Times are `time.monotonic()` seconds.
 """
