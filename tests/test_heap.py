@@ -1,5 +1,5 @@
 """The server's heap (`laserpick.server.heap`): arenas capped, large blocks mapped apart, and
-what a job freed given back when it ends."""
+the holes freed arrays left given back on release."""
 
 from __future__ import annotations
 

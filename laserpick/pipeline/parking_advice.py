@@ -1,7 +1,7 @@
 """How far the scooter should back up for the arm to take a grasp it cannot take from here.
 
 At a bookshelf parked close, the forearm comes down onto the board above the object for
-every posture of every grasp; 10 cm farther back it comes in level. When the reachability
+every posture of every grasp; from farther back it comes in level. When the reachability
 filter leaves no grasp, the same grasps are tried as they would lie after backing up
 straight by each of BACK_UP_STEPS: the grasps and the seen cloud move forward by that much
 in `base` (the scooter and its rider, which the checker models in `base`, stay). The first
