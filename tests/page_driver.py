@@ -7,9 +7,12 @@ through the API.
 from __future__ import annotations
 
 import math
+import re
 import time
+import urllib.request
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from urllib.parse import urljoin
 
 from basket import assert_in_basket
 from serve_process import ServeProcess
@@ -20,6 +23,7 @@ from laserpick.description import dims
 
 REPO = Path(__file__).resolve().parents[1]
 ARTIFACTS = REPO / "test-artifacts"
+STATIC = REPO / "laserpick" / "static"
 STEP = 0.05  #: rad: the page's default laser step (arrow, button)
 FINE = 0.01  #: rad: Shift+arrow
 VIEWPORT = {"width": 1280, "height": 800}
@@ -78,6 +82,56 @@ def close_page(page) -> None:
     page.close(run_before_unload=True)
     page.context.close()
     assert not errors, f"the page's script failed: {errors}"
+
+
+#: The MIME types of JavaScript: a browser runs no module script of another type (nor, under
+#: `X-Content-Type-Options: nosniff`, any script).
+JS_TYPES = ("text/javascript", "application/javascript")
+
+#: A GET: a path to the answer's status, lower-cased headers and body.
+Get = Callable[[str], tuple[int, dict[str, str], bytes]]
+
+
+def direct_get(server: ServeProcess) -> Get:
+    """GET straight from `server` (an error status raises)."""
+
+    def get(path: str) -> tuple[int, dict[str, str], bytes]:
+        with urllib.request.urlopen(server.url + path, timeout=10) as r:
+            return r.status, {k.lower(): v for k, v in r.headers.items()}, r.read()
+
+    return get
+
+
+def page_scripts(get: Get) -> set[str]:
+    """The paths of every script the page at `/` runs: those index.html names and every
+    module they import, each fetched with `get` and asserted served as JavaScript."""
+    status, _, html = get("/")
+    assert status == 200, html[:500]
+    named = re.findall(r'<script\b[^>]*\bsrc="([^"]+)"', html.decode())
+    todo = [urljoin("/", src) for src in named]
+    found: set[str] = set()
+    while todo:
+        path = todo.pop()
+        if path in found:
+            continue
+        found.add(path)
+        status, headers, body = get(path)
+        assert status == 200, f"{path}: {status}"
+        kind = headers.get("content-type", "").split(";")[0].strip()
+        assert kind in JS_TYPES, f"{path} is served as {kind!r}"
+        imports = re.findall(r'^import\b[^"]*"([^"]+)"', body.decode(), re.MULTILINE)
+        todo += [urljoin(path, spec) for spec in imports]
+    return found
+
+
+def page_script_files() -> set[str]:
+    """The paths at which the app serves every .js file of laserpick/static/ but the 3D
+    view's own (view.js, which the page at /view runs)."""
+    return {
+        "/static/" + p.relative_to(STATIC).as_posix()
+        for p in STATIC.rglob("*.js")
+        if p != STATIC / "view.js"
+    }
 
 
 def observer(server: ServeProcess) -> Client:

@@ -5,7 +5,7 @@ and the certificate).
 Through nginx, over HTTPS verified against that certificate:
 1. plain HTTP answers 301 to https;
 2. `/` (the console page) and `/api/v1/health` (JSON) come from the app, with the security
-   headers added;
+   headers added; every script of the page (page.js and its modules) comes as JavaScript;
 3. the `/api/v1/events` websocket upgrades, says hello, and streams state frames at its pace
    (no proxy buffering), with a heartbeat sent along the way;
 4. `/viser/` serves viser's client page (byte for byte what viser serves directly), and
@@ -28,6 +28,7 @@ from collections.abc import Iterator
 
 import pytest
 from nginx_site import NEEDS_NGINX, Stack, site_stack
+from page_driver import page_script_files, page_scripts
 
 # The asyncio client, not websockets.sync: the sync client reads its TLS socket on a thread of
 # its own while the caller writes, and one OpenSSL session must not be used from two threads
@@ -69,6 +70,12 @@ def test_page_and_health_through_the_proxy(stack: Stack) -> None:
     status, headers, body = stack.get("/")
     assert status == 200, body[:500]
     assert headers["content-type"].startswith("text/html")
+
+
+def test_the_page_s_scripts_through_the_proxy(stack: Stack) -> None:
+    # A browser runs a module script only when it comes as JavaScript (and nosniff holds the
+    # others to that too): the proxy passes the app's types through.
+    assert page_scripts(stack.get) == page_script_files()
 
 
 def test_events_websocket_streams_state_through_the_proxy(stack: Stack) -> None:

@@ -3,7 +3,8 @@
 
 1. The page loads, embeds the 3D view, and the view renders (test-artifacts/page.png); the
    mug marked by arrow keys and Detect shows lit, with its grasps (page-grasps.png). The
-   page takes the laser's nudge limit from the server's /health.
+   page takes the laser's nudge limit from the server's /health. Its scripts (page.js and
+   the modules of page/) are served as JavaScript, and the package ships every file of it.
 2. Every control has an accessible name (Chromium's own computation) and a target of 44 px
    or more.
 3. A keyboard-only pick: Tab, Space and arrow keys aim the laser at the mug (the presses are
@@ -16,18 +17,24 @@ Switch scanning, the gamepad, Esc and driving: test_page_switch_and_pad.py.
 from __future__ import annotations
 
 import time
+import tomllib
 from urllib.parse import parse_qs, urlsplit
 
 import pytest
 from page_driver import (
     ARTIFACTS,
+    REPO,
+    STATIC,
     aim_by_keys,
     close_page,
+    direct_get,
     finish_pick,
     fresh_scene,
     mug,
     observer,
     open_page,
+    page_script_files,
+    page_scripts,
     tab_to,
     wait_state,
 )
@@ -81,6 +88,11 @@ def wait_rendered(page) -> None:
     time.sleep(3.0)
 
 
+#: The page's module of shared state (laserpick/static/page/shared.js), imported in the page
+#: from the address the page's own modules import it from.
+_SHARED_MODULE = "import(new URL('static/page/shared.js', document.baseURI).href)"
+
+
 def view_src(frame) -> tuple[str, str | None, str | None]:
     """The 3D view iframe's address: its path, and its fixedDpr and multisample settings."""
     src = urlsplit(frame.get_attribute("src"))
@@ -116,9 +128,14 @@ def _renders(page, server: ServeProcess) -> None:
     assert page.locator("#projector").evaluate("img => img.complete && img.naturalWidth > 0")
     page.wait_for_function("/\\d+ ms/.test(document.getElementById('age').textContent)")
     assert page.get_by_role("button", name="STOP", exact=True).is_visible()
-    # The laser's nudge limit is the server's (GET /health), not one of the page's own.
+    # The laser's nudge limit is the server's (GET /health), not one of the page's own: the
+    # value the page nudges with, read from its module (a module is one instance per address,
+    # so this is the page's own, which its newest frame shows).
     health = observer(server).get("/health")
-    assert page.evaluate("maxNudge") == health.get("max_nudge")
+    nudge_limit, has_frame = page.evaluate(
+        _SHARED_MODULE + ".then(({ shared }) => [shared.maxNudge, shared.latest !== null])"
+    )
+    assert has_frame and nudge_limit == health.get("max_nudge")
 
     # The mug marked by arrow keys and Detect: the lit target and the grasp outlines in the
     # view, the projector image and the grasp's factors in the panel. Then Cancel.
@@ -142,6 +159,19 @@ def _renders(page, server: ServeProcess) -> None:
     assert '"viewDetail":"full"' in page.evaluate(
         "localStorage.getItem('laserpick.settings.operator')"
     )
+
+
+def test_the_page_s_scripts_are_javascript_and_shipped(server: ServeProcess) -> None:
+    """Every script the page runs comes with a JavaScript type (a browser runs no module
+    script of another), and they are every .js of static/ but the 3D view's. pyproject's
+    package data names every file of static/, page/ too: the container's `pip install .`
+    ships only those."""
+    assert page_scripts(direct_get(server)) == page_script_files()
+    data = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+    package = STATIC.parent
+    shipped = {p for g in data["package-data"]["laserpick"] for p in package.glob(g)}
+    missing = {p for p in STATIC.rglob("*") if p.is_file()} - shipped
+    assert not missing, sorted(str(p.relative_to(package)) for p in missing)
 
 
 # --- 2. accessible names and target sizes -----------------------------------------------
