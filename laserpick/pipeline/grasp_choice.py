@@ -5,8 +5,10 @@ The strategy's candidates (`strategies`) go through the reachability filter, are
 004's objective and clustered by position. When GPD's candidates offer no reachable grasp,
 it tries again on the target with its unseen back filled in by symmetry; when still none is
 reachable, the "vertical" grasp instead; when that is not reachable either, GPD again with
-the hand tilted about its closing axis. Each stage is timed. Frames: `base`, metres,
-radians.
+the hand tilted about its closing axis. A grasp counts as reachable there only if its
+straight approach is clear too: the filter checks the postures at its ends, and the planner
+would find the line between them blocked only at Go, when no other pass can run. Each stage
+is timed. Frames: `base`, metres, radians.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -34,7 +36,13 @@ from laserpick.pipeline.collision import (
 from laserpick.pipeline.free_space import beyond_view
 from laserpick.pipeline.parking_advice import back_up_advice
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
+from laserpick.pipeline.plan import (
+    APPROACH_BLOCKED,
+    PickPlan,
+    Searches,
+    approach_clear,
+    plan_pick,
+)
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled
 from laserpick.pipeline.selection import GraspClusters, group, score
@@ -156,8 +164,9 @@ def find_grasps(
     pool = FilteredCandidates(perception, q_ref, s, rng, world, timings)
     pool.checked = [] if isinstance(found, Failure) else pool.reachable(found)
     timings["filter"] += time.perf_counter() - t0
+    blocked = strategy == "gpd" and pool.none_reachable()
     strategy = pool.fall_back(strategy)
-    checked = pool.checked
+    checked = pool.without_blocked() if blocked else pool.checked
     if isinstance(found, Failure) and not checked:
         return found
     if not checked:
@@ -168,7 +177,7 @@ def find_grasps(
         t0 = time.perf_counter()
         back = back_up_advice(checked, world, q_ref, s.motion)
         timings["filter"] += time.perf_counter() - t0
-        return unreachable(len(checked), rejected[0].ik_failure, back)
+        return unreachable(len(checked), nearest_miss(rejected), back)
 
     t0 = time.perf_counter()
     mark = perception.mark.point
@@ -180,8 +189,15 @@ def find_grasps(
     )
 
 
+def nearest_miss(rejected: Sequence[Grasp]) -> str | None:
+    """Why the grasp that came nearest to being taken was not: a blocked straight approach
+    (its postures were clear) before the first grasp's reason."""
+    blocked = any(g.ik_failure == APPROACH_BLOCKED for g in rejected)
+    return APPROACH_BLOCKED if blocked else rejected[0].ik_failure
+
+
 def unreachable(grasps: int, reason: str | None, back: float | None) -> Failure:
-    """Why none of `grasps` grasps can be taken (`reason`, the first one's), and, where
+    """Why none of `grasps` grasps can be taken (`reason`: `nearest_miss`), and, where
     backing up `back` (m) would let the arm take one, that the user should."""
     msg = f"The arm cannot take any of {grasps} grasps ({reason})."
     if back is not None:
@@ -236,6 +252,8 @@ class FilteredCandidates:
     world: CollisionChecker
     timings: dict[str, float]
     checked: list[Grasp] = field(default_factory=list)
+    #: Whether the straight approach of `checked[i]` is clear, for those checked so far.
+    approaches: dict[int, bool] = field(default_factory=dict)
 
     def reachable(self, grasps: Sequence[Grasp]) -> list[Grasp]:
         """`grasps` through the reachability filter (`reach.reachable`)."""
@@ -261,13 +279,39 @@ class FilteredCandidates:
         return True
 
     def none_reachable(self) -> bool:
-        """Whether no grasp checked so far is reachable."""
-        return not any(g.ik is not None for g in self.checked)
+        """Whether no grasp checked so far can be taken: none is reachable, or the straight
+        approach of every reachable one is blocked (the filter checks the postures at its
+        ends, not the line between them). Approaches are checked in the order filtered, only
+        up to the first clear one: a check costs about 1 ms, and the filter passes hundreds
+        of grasps on the open table."""
+        reached = (i for i, g in enumerate(self.checked) if g.ik is not None)
+        return not any(self._clear_approach(i) for i in reached)
+
+    def without_blocked(self) -> list[Grasp]:
+        """`checked`, with the grasps whose straight approach is blocked counted as
+        unreachable, for that reason: those checked up to the first clear one
+        (`none_reachable`), all of them where none is clear."""
+        self.none_reachable()
+        return [
+            g
+            if self.approaches.get(i, True)
+            else replace(g, ik=None, ik_failure=APPROACH_BLOCKED)
+            for i, g in enumerate(self.checked)
+        ]
+
+    def _clear_approach(self, i: int) -> bool:
+        """Whether the straight approach to `checked[i]` is clear of the world (once each)."""
+        if i not in self.approaches:
+            t0 = time.perf_counter()
+            q = self.checked[i].ik
+            self.approaches[i] = approach_clear(q, self.world, self.settings.motion)
+            self.timings["filter"] += time.perf_counter() - t0
+        return self.approaches[i]
 
     def fall_back(self, strategy: Strategy) -> Strategy:
-        """For "gpd" with no reachable grasp, the other passes, in order, while none is:
-        completed by symmetry, vertical, tilted. The strategy the grasps are then from
-        ("vertical" when that pass gave the reachable ones)."""
+        """For "gpd" with no grasp that can be taken (`none_reachable`), the other passes, in
+        order, while none can: completed by symmetry, vertical, tilted. The strategy the
+        grasps are then from ("vertical" when that pass gave the reachable ones)."""
         gpd = strategy == "gpd"
         if gpd and self.none_reachable():
             # GPD needs both sides of a grasp in view. Seen from the front only (a tall bottle

@@ -5,9 +5,9 @@ every posture of every grasp; from farther back it comes in level. When the reac
 filter leaves no grasp, the same grasps are tried as they would lie after backing up
 straight by each of BACK_UP_STEPS: the grasps and the seen cloud move forward by that much
 in `base` (the scooter and its rider, which the checker models in `base`, stay). The first
-step from which some grasp has a collision-free posture is what the robot asks for. Only
-postures are checked, against what the cameras saw from here; the view from there decides
-the grasps after the drive.
+step from which some grasp has a collision-free posture and a clear straight approach is
+what the robot asks for. They are checked against what the cameras saw from here; the view
+from there decides the grasps after the drive.
 
 Frames: `base` (x forward, the scooter's heading), metres.
 """
@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.plan import approach_clear
 from laserpick.pipeline.reach import reachable
 from laserpick.settings import MotionSettings
 from laserpick.types import Grasp
@@ -54,7 +55,8 @@ def back_up_advice(
 ) -> float | None:
     """The least of `steps` (m) the scooter should back up for the arm to take one of
     `grasps` (from the filter, none reachable here) without touching what `world` holds, as
-    the reachability filter judges from q_ref (6,) rad; None when no step serves."""
+    the reachability filter judges from q_ref (6,) rad and with a clear straight approach;
+    None when no step serves."""
     if not grasps:
         return None
     sample = list(grasps[:: max(1, -(-len(grasps) // ADVICE_GRASPS))])
@@ -64,6 +66,6 @@ def back_up_advice(
         )
         moved = backed_up_grasps(sample, back)
         found = reachable(moved, there, q_ref, motion.approach_distance, motion.lift_least)
-        if any(g.ik is not None for g in found):
+        if any(g.ik is not None and approach_clear(g.ik, there, motion) for g in found):
             return back
     return None

@@ -41,6 +41,9 @@ UNSEEN_SAMPLES = 300
 BLIND_LEGS = 3
 #: The gripper housing's capsule radius (m), the first of `GRIPPER_CAPSULES`.
 HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
+#: Why a grasp whose postures at both ends of its straight approach are clear is still one
+#: the arm cannot take.
+APPROACH_BLOCKED = "the straight approach to this grasp is blocked"
 
 
 def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
@@ -347,6 +350,32 @@ def transit_path(
     return transit
 
 
+def straight_approach(
+    q_grasp: np.ndarray, world: CollisionChecker, s: MotionSettings
+) -> np.ndarray | Failure:
+    """Joint waypoints (K, 6) rad of the straight approach to the grasp whose IK solution is
+    q_grasp (6,) rad: from the pre-grasp, `approach_distance` back along the approach axis,
+    on q_grasp's IK branch, to the grasp, every `cartesian_step`. The arm is checked against
+    the `world` all the way; the hand is not (grasp detection swept it in along this line).
+    A Failure when the pre-grasp does not solve, the line leaves the branch, or the arm
+    meets the world on it."""
+    T_grasp = tcp_pose(q_grasp)
+    pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
+    if len(pre) == 0:
+        return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
+    approach = cartesian_line(pre[0], T_grasp, s.cartesian_step)
+    if approach is None or not world.clearance_ok(approach, hand=False).all():
+        return Failure("ik_plan", f"{APPROACH_BLOCKED.capitalize()}.")
+    approach[-1] = q_grasp
+    return approach
+
+
+def approach_clear(q_grasp: np.ndarray, world: CollisionChecker, s: MotionSettings) -> bool:
+    """Whether the straight approach to the grasp at q_grasp (6,) rad is clear of the `world`
+    (`straight_approach`)."""
+    return not isinstance(straight_approach(q_grasp, world, s), Failure)
+
+
 def plan_pick(
     q_now: np.ndarray,
     q_grasp: np.ndarray,
@@ -387,14 +416,10 @@ def plan_pick(
     T_grasp = tcp_pose(q_grasp)
     if check_hand and not hand_fits(q_grasp, T_grasp, surroundings):
         return Failure("ik_plan", "The hand would hit something beside the object.")
-    pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
-    if len(pre) == 0:
-        return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
-    q_pre = pre[0]
-    approach = cartesian_line(q_pre, T_grasp, s.cartesian_step)
-    if approach is None or not world.clearance_ok(approach, hand=False).all():
-        return Failure("ik_plan", "The straight approach to this grasp is blocked.")
-    approach[-1] = q_grasp
+    approach = straight_approach(q_grasp, world, s)
+    if isinstance(approach, Failure):
+        return approach
+    q_pre = approach[0]
     up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
