@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, isolation_robot, pick_object
 from basket import assert_in_basket
+from scipy.spatial.transform import Rotation
 
 from laserpick.behaviours import Behaviours, basket_opening, drop_candidates, drop_configurations
 from laserpick.bench.referee import Referee
@@ -21,6 +22,7 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.transforms import planar_pose, rotx
 
 
 @pytest.fixture
@@ -229,3 +231,39 @@ def test_the_drop_judge_fails_every_miss(offset: tuple[float, float], said: str)
     else:
         pytest.fail("a mug outside the basket passed")
     assert_in_basket(_mug_record((-0.4, 0.3), in_basket=True))
+
+
+@pytest.mark.parametrize("inside", [True, False], ids=["against-the-wall", "beside-the-basket"])
+def test_an_object_lying_against_the_basket_wall_is_in_it(robot, inside: bool) -> None:
+    """A spray bottle lying on its side in the basket, its bottom pressed against the right
+    wall (as a fall leaves an object: the contact lets it a fraction of a millimetre into
+    the wall), is in the basket, though its origin, the middle of its bottom face, is past
+    the wall's face. The same bottle let fall 20 cm left of the basket is not."""
+    referee = Referee(robot)
+    name = "spray_bottle_1"
+    lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2  # the walls' inner faces, the floor
+    hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
+    # On its side, pointing left (+y in `base`).
+    y = lo[1] + 0.002 if inside else hi[1] + 0.20
+    T_world_base = planar_pose(*robot.base_pose())
+    at = (T_world_base @ np.array([dims.BASKET_CENTER[0], y, lo[2] + 0.04, 1.0]))[:3]
+    lying = Rotation.from_matrix(T_world_base[:3, :3] @ rotx(-np.pi / 2)).as_quat()
+    push = T_world_base[:3, :3] @ [
+        0.0,
+        -1.0,
+        0.0,
+    ]  # N, toward the right wall: a sixth of its weight
+    body = robot.sim.info.object_bodies[name]
+
+    def press(m, d) -> None:
+        d.xfrc_applied[body, :3] = push if inside else 0.0
+
+    robot.sim.call(press)
+    referee.put_back(name, np.r_[at, lying[[3, 0, 1, 2]]])  # MuJoCo's quaternion: w first
+    robot.sleep(1.0)
+    if inside:
+        assert referee.position(name)[1] < lo[1], "the origin lies past the wall's face"
+        assert referee.in_basket(name)
+    else:
+        assert referee.centre_of_mass(name)[1] > hi[1], "it fell beside the basket"
+        assert not referee.in_basket(name)

@@ -195,9 +195,11 @@ class SimTruth:
         self.robot.sleep(0.3)
 
     def in_basket(self, instance: str) -> bool:
-        """Whether the object's origin lies inside the basket: within its walls, above its
-        floor and below its rim (with a little slack for a tall object leaning there)."""
-        p = self.position(instance)
+        """Whether the object lies in the basket: its centre of mass within the basket's
+        walls, above its floor and below its rim (with a little slack for a tall object
+        leaning there). Not its origin, the middle of its bottom face: an object lying on its
+        side with its bottom against a wall has its origin on the wall."""
+        p = self.centre_of_mass(instance)
         lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
         hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
         return bool(np.all(p >= lo - [0.0, 0.0, 0.02]) and np.all(p <= hi + [0.0, 0.0, 0.05]))
