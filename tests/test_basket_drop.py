@@ -267,3 +267,31 @@ def test_an_object_lying_against_the_basket_wall_is_in_it(robot, inside: bool) -
     else:
         assert referee.centre_of_mass(name)[1] > hi[1], "it fell beside the basket"
         assert not referee.in_basket(name)
+
+
+def test_an_object_over_the_opening_above_the_rim_is_not_in_the_basket(robot) -> None:
+    """A spray bottle lying over the opening with its middle 3 cm above the rim, as a box
+    lying across the opening on the rims has it, is not in the basket; let fall, it is."""
+    referee = Referee(robot)
+    name = "spray_bottle_1"
+    rim = dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
+    T_world_base = planar_pose(*robot.base_pose())
+    body = robot.sim.info.object_bodies[name]
+    lying = T_world_base[:3, :3] @ rotx(-np.pi / 2)
+    # Where the origin goes for the middle to be over the basket's centre, 3 cm above the rim.
+    middle = np.array([*dims.BASKET_CENTER[:2], rim + 0.03])
+    origin = middle - lying @ robot.model.body_ipos[body]
+    at = (T_world_base @ np.append(origin, 1.0))[:3]
+    quat = Rotation.from_matrix(lying).as_quat()[[3, 0, 1, 2]]  # MuJoCo's: w first
+
+    def hold_there(m, d) -> None:
+        j = m.joint(f"obj/{name}")
+        d.qpos[j.qposadr[0] : j.qposadr[0] + 7] = np.r_[at, quat]
+        d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
+
+    robot.sim.call(hold_there)
+    robot.sleep(0.004)  # the call lands at the next step; in 4 ms it falls 0.1 mm
+    assert abs(referee.centre_of_mass(name)[2] - (rim + 0.03)) < 0.002
+    assert not referee.in_basket(name)
+    robot.sleep(1.0)
+    assert referee.in_basket(name)

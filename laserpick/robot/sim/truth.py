@@ -196,13 +196,15 @@ class SimTruth:
 
     def in_basket(self, instance: str) -> bool:
         """Whether the object lies in the basket: its centre of mass within the basket's
-        walls, above its floor and below its rim (with a little slack for a tall object
-        leaning there). Not its origin, the middle of its bottom face: an object lying on its
-        side with its bottom against a wall has its origin on the wall."""
+        walls and below its rim. Not its origin, the middle of its bottom face: an object
+        lying on its side with its bottom against a wall has its origin on the wall. Below
+        the rim, not a little above it: a box lying across the opening, on the rims, has its
+        middle a few centimetres above them, and the tallest object standing in the basket
+        (30 cm) has it below."""
         p = self.centre_of_mass(instance)
         lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
         hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
-        return bool(np.all(p >= lo - [0.0, 0.0, 0.02]) and np.all(p <= hi + [0.0, 0.0, 0.05]))
+        return bool(np.all(p >= lo) and np.all(p <= hi))
 
 
 @dataclass
