@@ -200,7 +200,7 @@ class SimTruth:
         lying on its side with its bottom against a wall has its origin on the wall. Below
         the rim, not a little above it: a box lying across the opening, on the rims, has its
         middle a few centimetres above them, and the tallest object standing in the basket
-        (30 cm) has it below."""
+        (the 25 cm cereal box) has it 12.5 cm above the floor, under the 16 cm deep rim."""
         p = self.centre_of_mass(instance)
         lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
         hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
