@@ -1,7 +1,7 @@
 // What several modules read and write, in one place: the page's lease token, the newest
 // state frame, the server's nudge limit; and the robot states in which the laser may be aimed.
 
-// Robot states in which the laser may be aimed (the server's AIMABLE).
+// The server's AIMABLE.
 export const AIMABLE = new Set(["idle", "aiming", "perceived", "grasps_ready", "holding", "awaiting_place"]);
 
 export const shared = {
