@@ -19,6 +19,7 @@ __all__ = [
     "basket_opening",
     "drop_candidates",
     "drop_configurations",
+    "laid_in_candidates",
     "past_the_opening",
     "rank_drop_postures",
 ]
@@ -96,8 +97,11 @@ def drop_configurations(
     would pull the middle it is held by off the real object's, and let it fall beside the
     basket.
 
+    Where the grid holds too few wholly inside, the postures that lay this object in
+    (`laid_in_candidates`) are ranked with the tilted ones.
+
     Postures that hold every point of the object inside the opening (1 cm in from the
-    walls) come first, upright before tilted, each by the shortest fall (in `fall_step`
+    walls) come first, upright before laid in and tilted, each by the shortest fall (in `fall_step`
     steps: a long fall bounces the object out), then the nearest to q_ref. Then those
     that hold its middle there, upright and tilted together (`rank_drop_postures`).
     A posture that does not hold even the middle over the opening is left out: an object
@@ -110,12 +114,53 @@ def drop_configurations(
     upright = drop_candidates(heights=settings.drop_heights)
     ranked = rank_drop_postures(upright, q_ref, checker, payload, falls, settings)
     if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
+        laid = laid_in_candidates(np.vstack([payload, falls]), q_ref, settings.drop_lows)
         tilted = drop_candidates(tilted=True, heights=settings.drop_heights)
-        ranked += rank_drop_postures(tilted, q_ref, checker, payload, falls, settings)
+        for more in (laid, tilted):
+            ranked += rank_drop_postures(more, q_ref, checker, payload, falls, settings)
         inside = [kq for kq in ranked if kq[0][0] == 0]
         past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
         ranked = inside + past
     return [q for _, q in ranked]
+
+
+def laid_in_candidates(
+    held: np.ndarray, q_ref: np.ndarray, lows: Sequence[float]
+) -> list[np.ndarray]:
+    """Joint configurations (rad) that lay the held object (`held`, its points (P, 3) in
+    the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point `lows` (m) over the basket's
+    floor, its outline over the opening at the middle and at either side of the room it has
+    there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns whose
+    outline fits the opening are tried, and only configurations clear of the scooter are
+    kept (the object itself is checked when they are ranked).
+
+    The fixed grid of `drop_candidates` places the hand, not the object: a cereal box held
+    1.4 cm off its middle reached 3 mm past the opening from every posture of the grid that
+    turned it the right way, and was let go across the rims from higher up instead."""
+    if len(held) == 0:
+        return []
+    lo, hi = basket_opening()
+    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    free = CollisionChecker(np.zeros((0, 3)))
+    out: list[np.ndarray] = []
+    for yaw, tilt in itertools.product(
+        np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30))
+    ):
+        R = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down, then turned
+        turned = held @ R.T
+        low, high = turned.min(axis=0), turned.max(axis=0)
+        room = (hi - lo) - (high - low)[:2]
+        if (room < 0).any():
+            continue
+        # In whole cm, rounded down: a spot never reaches past the room it has.
+        spots = itertools.product(*(np.unique(np.floor([0, 50 * r, 100 * r]) / 100) for r in room))
+        for (sx, sy), above in itertools.product(spots, lows):
+            T = np.eye(4)
+            T[:3, :3] = R
+            T[:3, 3] = [lo[0] + sx - low[0], lo[1] + sy - low[1], floor + above - low[2]]
+            Q = ik_tcp(T, q_ref)
+            out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
+    return out
 
 
 def basket_opening() -> tuple[np.ndarray, np.ndarray]:
