@@ -11,7 +11,7 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline.collision import CollisionChecker, held_at
+from laserpick.pipeline.collision import PAYLOAD_POINT_RADIUS, CollisionChecker, held_at
 from laserpick.settings import BehaviourSettings, get_settings
 from laserpick.transforms import roty, rotz
 
@@ -114,7 +114,8 @@ def drop_configurations(
     upright = drop_candidates(heights=settings.drop_heights)
     ranked = rank_drop_postures(upright, q_ref, checker, payload, falls, settings)
     if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
-        laid = laid_in_candidates(np.vstack([payload, falls]), q_ref, settings.drop_lows)
+        held = np.vstack([payload, falls])
+        laid = laid_in_candidates(held, q_ref, settings.drop_lows, checker.margin)
         tilted = drop_candidates(tilted=True, heights=settings.drop_heights)
         for more in (laid, tilted):
             ranked += rank_drop_postures(more, q_ref, checker, payload, falls, settings)
@@ -125,12 +126,13 @@ def drop_configurations(
 
 
 def laid_in_candidates(
-    held: np.ndarray, q_ref: np.ndarray, lows: Sequence[float]
+    held: np.ndarray, q_ref: np.ndarray, lows: Sequence[float], margin: float
 ) -> list[np.ndarray]:
     """Joint configurations (rad) that lay the held object (`held`, its points (P, 3) in
-    the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point `lows` (m) over the basket's
-    floor, its outline over the opening at the middle and at either side of the room it has
-    there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns whose
+    the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point
+    `lows` (m) over the basket's floor, its outline within the opening and `margin` (m, the
+    clearance the check keeps) off the walls, at the middle and at either side of the room
+    it has there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns whose
     outline fits the opening are tried, and only configurations clear of the scooter are
     kept (the object itself is checked when they are ranked).
 
@@ -139,13 +141,12 @@ def laid_in_candidates(
     turned it the right way, and was let go across the rims from higher up instead."""
     if len(held) == 0:
         return []
-    lo, hi = basket_opening()
+    half = dims.BASKET_INNER[:2] / 2 - max(margin + PAYLOAD_POINT_RADIUS, 0.01)
+    lo, hi = dims.BASKET_CENTER[:2] - half, dims.BASKET_CENTER[:2] + half
     floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
     free = CollisionChecker(np.zeros((0, 3)))
     out: list[np.ndarray] = []
-    for yaw, tilt in itertools.product(
-        np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30))
-    ):
+    for yaw, tilt in itertools.product(np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30))):
         R = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down, then turned
         turned = held @ R.T
         low, high = turned.min(axis=0), turned.max(axis=0)
