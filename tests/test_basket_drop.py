@@ -172,6 +172,20 @@ def test_postures_that_hold_an_object_partly_past_the_opening_rank_upright_and_t
     assert any(upright) and not upright[0], "a tilted posture before the upright ones"
 
 
+def test_nothing_is_let_go_reaching_past_the_back_wall_toward_the_rider():
+    """A box too large to be held wholly over the opening may be let go partly past its
+    front or its sides, never past its back edge: there are the tiller, the handlebars and
+    the rider's hands, where a cereal box let go partly past came to rest."""
+    payload = box_points((0.26, 0.20, 0.10))
+    free = CollisionChecker(np.zeros((0, 3)))
+    drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
+    assert drops and all(past_and_fall(q, payload)[0] > 0 for q in drops)
+    back_edge = basket_opening()[0][0]
+    for q in drops:
+        T = tcp_pose(q)
+        assert (payload @ T[:3, :3].T + T[:3, 3])[:, 0].min() >= back_edge
+
+
 def test_a_drop_holds_over_the_opening_the_object_as_seen_not_the_part_guessed_past_the_view():
     """A juice bottle lying on the 108 cm table, seen 9 cm of its 20.6 cm and held at the
     middle of that: the carry keeps clear a shape carried on past the view's edge to 25 cm

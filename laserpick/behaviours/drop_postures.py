@@ -105,7 +105,8 @@ def drop_configurations(
     steps: a long fall bounces the object out), then the nearest to q_ref. Then those
     that hold its middle there, upright and tilted together (`rank_drop_postures`).
     A posture that does not hold even the middle over the opening is left out: an object
-    let go there would fall beside the basket, onto the scooter or the floor. Empty when
+    let go there would fall beside the basket, onto the scooter or the floor. So is one that
+    holds any of it past the opening's back edge, over the tiller and the rider's hands. Empty when
     none is left.
     The basket sits close beside the arm's base, between the tiller, the sensor posts and
     the projector, so few postures reach over it: they are searched, not assumed.
@@ -188,9 +189,10 @@ def rank_drop_postures(
     settings: BehaviourSettings,
 ) -> list[tuple[DropRank, np.ndarray]]:
     """The clear `candidates` (clear with `payload`, TCP frame, m) that hold the middle of
-    the object as it falls (`falls`, TCP frame, m) over the opening, each with its rank key,
-    sorted. Wholly inside the opening: (0, 0, 0, fall, nearness); partly past it: (1,
-    coarse fall, steps past, fall, nearness). The fall is the object's lowest point over the
+    the object as it falls (`falls`, TCP frame, m) over the opening, and none of it past the
+    opening's back edge, toward the rider, each with its rank key, sorted. Wholly inside the
+    opening: (0, 0, 0, fall, nearness); partly past it: (1, coarse fall, steps past, fall,
+    nearness). The fall is the object's lowest point over the
     basket's floor in `fall_step` steps (coarse: `overhang_fall_step`), the reach past the
     opening in `overhang_step` steps, and nearness the largest joint's distance from
     `q_ref` (rad)."""
@@ -201,8 +203,11 @@ def rank_drop_postures(
     T = tcp_pose(Q)
     pts = falls if len(falls) else np.zeros((1, 3))
     held = held_at(T, pts)  # (B, P, 3)
-    middle_in = past_the_opening(held.mean(axis=1)) == 0
-    Q, held = Q[middle_in], held[middle_in]
+    # Past the back wall are the tiller, the handlebars and the rider's hands: nothing is let
+    # go reaching over it. A cereal box let go partly past it came to rest on the handlebars.
+    rider_side = (basket_opening()[0][0] - held[..., 0]).max(axis=1) > 0
+    keep = (past_the_opening(held.mean(axis=1)) == 0) & ~rider_side
+    Q, held = Q[keep], held[keep]
     # In chunks: the check's arrays grow with candidates x payload points x spheres.
     clear = np.concatenate(
         [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]
