@@ -204,7 +204,7 @@ def rank_drop_postures(
     pts = falls if len(falls) else np.zeros((1, 3))
     held = held_at(T, pts)  # (B, P, 3)
     # Past the back wall are the tiller, the handlebars and the rider's hands: nothing is let
-    # go reaching over it. A cereal box let go partly past it came to rest on the handlebars.
+    # go reaching over it: a cereal box let go near it came to rest on the handlebars.
     rider_side = (basket_opening()[0][0] - held[..., 0]).max(axis=1) > 0
     keep = (past_the_opening(held.mean(axis=1)) == 0) & ~rider_side
     Q, held = Q[keep], held[keep]
