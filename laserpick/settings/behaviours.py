@@ -73,12 +73,20 @@ class BehaviourSettings(BaseModel):
         " objects, the high ones for a tall object held near its top, which hangs deep below"
         " the hand. Ours.",
     )
+    drop_lows: tuple[float, ...] = Field(
+        (0.04, 0.08),
+        description="Heights (m) of a held object's lowest point over the basket's floor where"
+        " the arm lays it in (`laid_in_candidates`), when too few postures of the fixed grid"
+        " hold it wholly over the opening: 4 cm keeps the object's 1 cm points and the 1 cm"
+        " clearance off the floor's 1.3 cm keep-out. Ours.",
+    )
     drop_tries: int = Field(
         3,
         ge=1,
-        description="Drop postures tried in turn when no path to the better ones is found;"
-        " where fewer than this hold the whole object over the opening, the tilted postures"
-        " are ranked too. Ours.",
+        description="Drop postures tried in turn when no path to the better ones is found,"
+        " and as many again unlike them where none of those is reached; where fewer than"
+        " this hold the whole object over the opening, the laid-in and tilted postures are"
+        " ranked too. Ours.",
     )
     fall_step: float = Field(
         0.04,
