@@ -20,6 +20,7 @@ from laserpick.behaviours.drop_postures import (
     drop_configurations,
     past_the_opening,
     rank_drop_postures,
+    unlike,
 )
 from laserpick.behaviours.guarded_motion import GuardedMotion
 from laserpick.behaviours.hand import GRIPPER_TIME
@@ -69,6 +70,7 @@ __all__ = [
     "place_poses",
     "rank_drop_postures",
     "turned_hand_xy",
+    "unlike",
     "without_leftovers",
 ]
 
