@@ -18,10 +18,7 @@ from laserpick.behaviours import (
     drop_candidates,
     drop_configurations,
     rank_drop_postures,
-    unlike,
 )
-from laserpick.behaviours.outcome import Outcome
-from laserpick.bench.protocols import PROTOCOLS, Options
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -30,7 +27,6 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
-from laserpick.types import Failure
 
 
 @pytest.fixture
@@ -239,75 +235,6 @@ def test_a_tall_object_is_picked_and_dropped_in_the_basket():
         assert referee.in_basket(name)
     finally:
         robot.close()
-
-
-
-def _hand_apart(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """How far apart (m) and turned apart (deg) postures a and b (rad) hold the hand."""
-    Ta, Tb = tcp_pose(a), tcp_pose(b)
-    cos = float(np.clip(Ta[:3, 2] @ Tb[:3, 2], -1.0, 1.0))
-    return float(np.linalg.norm(Ta[:3, 3] - Tb[:3, 3])), math.degrees(math.acos(cos))
-
-
-def test_postures_unlike_the_tried_ones_hold_the_hand_away_from_each():
-    """The best postures that lay a tall box in lie within centimetres of one another; the
-    ones `unlike` keeps hold the hand 6 cm or 30 deg from each of them, in rank order."""
-    payload = box_points((0.19, 0.06, 0.24))
-    free = CollisionChecker(np.zeros((0, 3)))
-    drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
-    best, rest = drops[: BEHAVIOUR.drop_tries], drops[BEHAVIOUR.drop_tries :]
-    others = unlike(rest, best)
-    assert others and len(others) < len(rest), "some kept, the near ones left out"
-    for q in others:
-        assert all(d > 0.06 or turn > 30.0 for d, turn in (_hand_apart(q, t) for t in best))
-    for q in rest:
-        if not any(q is o for o in others):
-            assert any(d <= 0.06 and turn <= 30.0 for d, turn in (_hand_apart(q, t) for t in best))
-    order = [next(i for i, r in enumerate(rest) if r is o) for o in others]
-    assert order == sorted(order)
-
-
-def test_where_no_path_reaches_the_best_drop_postures_the_box_goes_in_from_one_unlike_them():
-    """The three best drop postures for a tall box are blocked, as the right sensor post
-    blocked the way to a cereal box laid in deep (isolation seed 27; the slow test below
-    replays it): here the planner's answer for them is forced to "no path". The carry then
-    reaches a posture 6 cm or 30 deg from each, and the box lands in the basket."""
-    robot = SimRobot(load_scene(str(DATA / "tall_object.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
-        name = "cereal_box_1"
-        b, referee = pick_object(robot, name)
-        go_to, blocked, reached = b.go_to, [], []
-
-        def blocking_the_best(q_goal, checker, what, **kw):
-            if what == "carrying to the basket" and len(blocked) < BEHAVIOUR.drop_tries:
-                blocked.append(q_goal)
-                return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
-            out = go_to(q_goal, checker, what, **kw)
-            if what == "carrying to the basket" and out.ok:
-                reached.append(q_goal)
-            return out
-
-        b.go_to = blocking_the_best  # type: ignore[method-assign]
-        dropped = b.drop_in_basket()
-        assert dropped.ok, dropped.failure
-        (q_drop,) = reached
-        for q in blocked:
-            d, turn = _hand_apart(q_drop, q)
-            assert d > 0.06 or turn > 30.0
-        robot.sleep(1.0)
-        assert referee.in_basket(name)
-    finally:
-        robot.close()
-
-
-@pytest.mark.slow
-def test_a_cereal_box_laid_in_deep_behind_the_sensor_post_reaches_the_basket():
-    """Isolation seed 27: the three best postures lay the cereal box in deep, and the right
-    sensor post and the projector block every way to them; one unlike them is reached."""
-    records = PROTOCOLS["isolation"].run(0, 27, Options())
-    (box,) = [r for r in records if r.instance == "cereal_box_1"]
-    assert box.success, box.message
 
 
 # --- the judge of the live tests' drops (tests/basket.py) ----------------------------------------

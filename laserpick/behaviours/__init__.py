@@ -20,7 +20,6 @@ from laserpick.behaviours.drop_postures import (
     drop_configurations,
     past_the_opening,
     rank_drop_postures,
-    unlike,
 )
 from laserpick.behaviours.guarded_motion import GuardedMotion
 from laserpick.behaviours.hand import GRIPPER_TIME
@@ -70,7 +69,6 @@ __all__ = [
     "place_poses",
     "rank_drop_postures",
     "turned_hand_xy",
-    "unlike",
     "without_leftovers",
 ]
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from laserpick.behaviours.carry import Carrying, holding_pose
-from laserpick.behaviours.drop_postures import drop_configurations, past_the_opening, unlike
+from laserpick.behaviours.drop_postures import drop_configurations, past_the_opening
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.messages import NOT_HOLDING, PAST_THE_OPENING
 from laserpick.behaviours.outcome import Outcome
@@ -45,8 +45,7 @@ class BasketDrop(Carrying, Stowing):
 
     def _carry_to_basket(self, held: Held) -> Outcome:
         """Rise clear, then carry `held` to the first of the best `drop_tries` postures over
-        the basket that a path reaches; where none does, to the first of the next best
-        `drop_tries` unlike them (`unlike`)."""
+        the basket that a path reaches."""
         b = self.settings.behaviour
         drops = drop_configurations(
             self.current_q(), held.surroundings, held.points_tcp, held.as_seen_tcp, settings=b
@@ -59,20 +58,7 @@ class BasketDrop(Carrying, Stowing):
         if failure is not None:
             return Outcome(failure)
         high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
-        best = drops[: b.drop_tries]
-        out = self._carry_to_one_of(best, held, high)
-        if out.failure is not None and out.failure.kind == "ik_plan":
-            # The best postures often lie close together, and what blocks the way to one
-            # blocks it to all: a cereal box laid in deep, three spots 2-5 cm apart, each
-            # behind the sensor post.
-            others = unlike(drops[b.drop_tries :], best)[: b.drop_tries]
-            out = self._carry_to_one_of(others, held, high) if others else out
-        return out
-
-    def _carry_to_one_of(self, drops: list[np.ndarray], held: Held, high: np.ndarray) -> Outcome:
-        """Carry `held` to the first of `drops` (rad) that a path reaches, through `high`
-        where no path goes straight there."""
-        for q_drop in drops:
+        for q_drop in drops[: b.drop_tries]:
             out = self.go_to(
                 q_drop,
                 held.surroundings,

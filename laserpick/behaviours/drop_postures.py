@@ -22,7 +22,6 @@ __all__ = [
     "laid_in_candidates",
     "past_the_opening",
     "rank_drop_postures",
-    "unlike",
 ]
 
 #: A rank key: (past the opening?, coarse fall, steps past, fall, nearness to the reference).
@@ -238,21 +237,3 @@ def rank_drop_postures(
     ]
     ranked.sort(key=lambda kq: kq[0])
     return ranked
-
-
-#: How far apart (m, the TCP's position) or turned apart (rad, the hand's pointing direction)
-#: two drop postures must be for a path to one to say little about a path to the other.
-UNLIKE_REACH = 0.06
-UNLIKE_TURN = np.radians(30.0)
-
-
-def unlike(drops: Sequence[np.ndarray], tried: Sequence[np.ndarray]) -> list[np.ndarray]:
-    """The postures of `drops` (rad, in their order) that hold the hand `UNLIKE_REACH` or
-    `UNLIKE_TURN` away from its pose in every posture of `tried` (rad)."""
-    if not drops or not tried:
-        return list(drops)
-    T, S = tcp_pose(np.array(drops)), tcp_pose(np.array(tried))
-    apart = np.linalg.norm(T[:, None, :3, 3] - S[None, :, :3, 3], axis=-1) > UNLIKE_REACH
-    cos = np.einsum("ai,bi->ab", T[:, :3, 2], S[:, :3, 2])
-    turned = cos < np.cos(UNLIKE_TURN)
-    return [q for q, keep in zip(drops, (apart | turned).all(axis=1), strict=True) if keep]
