@@ -83,10 +83,9 @@ class BehaviourSettings(BaseModel):
     drop_tries: int = Field(
         3,
         ge=1,
-        description="Drop postures tried in turn when no path to the better ones is found,"
-        " and as many again unlike them where none of those is reached; where fewer than"
-        " this hold the whole object over the opening, the laid-in and tilted postures are"
-        " ranked too. Ours.",
+        description="Drop postures tried in turn when no path to the better ones is found;"
+        " where fewer than this hold the whole object over the opening, the laid-in and"
+        " tilted postures are ranked too. Ours.",
     )
     fall_step: float = Field(
         0.04,
