@@ -205,8 +205,8 @@ class ScriptedOperator:
         # Aiming at the object, the user looks for the dot on it; aiming at a given point
         # (002's laser scan, which tries points up to the object's edges), they do not.
         on = rec.instance if aim is None else None
-        self._view = self.referee.view() if aim is None else None
-        aim = aim if self._view is None else self._view.top(rec.instance)
+        self._view = None
+        aim = self._look(rec.instance) if aim is None else aim
         if aim is None:
             rec.fail("detect_laser", "no camera sees the object")
             return False
@@ -228,15 +228,24 @@ class ScriptedOperator:
                 # try, as a person told so would, and mark again from there.
                 s.cancel(BENCH)
                 rec.backed_up = asked
-                self._view = self.referee.view() if self.back_up(asked) else None
-                aim = None if self._view is None else self._view.top(rec.instance)
-                if aim is None:  # could not park there, or no camera sees it from there
+                if not self.back_up(asked):  # could not park there
+                    self._view = None
+                    return False
+                aim = self._look(rec.instance)
+                if aim is None:  # no camera sees it from there
                     return False
                 continue
             if s.state != TaskState.AIMING:  # found the object, but no grasp: not the aim
                 break
         s.cancel(BENCH)
         return False
+
+    def _look(self, instance: str) -> np.ndarray | None:
+        """Look at the scene from where the user sits (kept as `_view`), and where they aim
+        at `instance`: the middle of its visible top (m, `base`); None where no camera sees
+        it."""
+        self._view = self.referee.view()
+        return self._view.top(instance)
 
     def choose(self, instance: str, seen: dict[str, np.ndarray]) -> None:
         """Manual selection (004 section 7.2): step through the clusters, best first, to the

@@ -51,6 +51,7 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
         for task, name in enumerate(limit(shuffled(op, instances(scene)), opt)):
             op.begin_task(task)
             spot = TaskSpot(op, scene, name)
+            op.back_up = spot.back_up
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 rec.task = task

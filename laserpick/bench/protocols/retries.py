@@ -51,17 +51,14 @@ def next_try(rec: Attempt, back: float, across: float, scene: Scene) -> tuple[fl
 @dataclass
 class TaskSpot:
     """Where the user parks for one task's tries: `back` m farther back than at first and
-    `across` m to the arm's left (as in `go_to_object`). Made for a task, it is also how the
-    user backs up when the robot asks (`ScriptedOperator.back_up`)."""
+    `across` m to the arm's left (as in `go_to_object`). Its `back_up` is how the user backs
+    up when the robot asks (the protocol hands it to `ScriptedOperator.back_up`)."""
 
     op: ScriptedOperator
     scene: Scene
     instance: str
     back: float = 0.0
     across: float = 0.0
-
-    def __post_init__(self) -> None:
-        self.op.back_up = self.back_up
 
     def go(self) -> bool:
         """Drive there; whether the user parked."""
