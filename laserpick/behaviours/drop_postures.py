@@ -94,8 +94,9 @@ def drop_configurations(
 ) -> list[np.ndarray]:
     """Clear joint configurations that hold the object over the basket's opening, best
     first (rad): those of `drop_candidates()`, and where fewer than `drop_tries` of them
-    hold the whole object inside, the tilted ones after them (an object that fits inside
-    from one upright posture only stays in the hand where no path reaches that one).
+    hold the whole object inside, the postures that lay this object in
+    (`laid_in_candidates`) and the tilted ones after them (an object that fits inside from
+    one upright posture only stays in the hand where no path reaches that one).
 
     payload (P, 3), TCP frame (m): the points kept clear of everything, as carried.
     falls (F, 3), TCP frame (m): the object as it falls when let go (default `payload`):
@@ -103,17 +104,14 @@ def drop_configurations(
     would pull the middle it is held by off the real object's, and let it fall beside the
     basket.
 
-    Where the grid holds too few wholly inside, the postures that lay this object in
-    (`laid_in_candidates`) are ranked with the tilted ones.
-
     Postures that hold every point of the object inside the opening (1 cm in from the
-    walls) come first, upright before laid in and tilted, each by the shortest fall (in `fall_step`
-    steps: a long fall bounces the object out), then the nearest to q_ref. Then those
-    that hold its middle there, upright and tilted together (`rank_drop_postures`).
+    walls) come first, upright before laid in and tilted, each by the shortest fall (in
+    `fall_step` steps: a long fall bounces the object out), then the nearest to q_ref. Then
+    those that hold its middle there, upright and tilted together (`rank_drop_postures`).
     A posture that does not hold even the middle over the opening is left out: an object
-    let go there would fall beside the basket, onto the scooter or the floor. So is one that
-    holds any of it past the opening's back edge, over the tiller and the rider's hands. Empty when
-    none is left.
+    let go there would fall beside the basket, onto the scooter or the floor. So is one
+    that holds any of it past the opening's back edge, over the tiller and the rider's
+    hands. Empty when none is left.
     The basket sits close beside the arm's base, between the tiller, the sensor posts and
     the projector, so few postures reach over it: they are searched, not assumed.
     """
@@ -139,9 +137,9 @@ def laid_in_candidates(
     the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point
     `lows` (m) over the basket's floor, its outline within the opening and `margin` (m, the
     clearance the check keeps) off the walls, at the middle and at either side of the room
-    it has there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns whose
-    outline fits the opening are tried, and only configurations clear of the scooter are
-    kept (the object itself is checked when they are ranked).
+    it has there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns
+    whose outline fits the opening are tried, and only configurations clear of the scooter
+    are kept (the object itself is checked when they are ranked).
 
     The fixed grid of `drop_candidates` places the hand, not the object: a cereal box held
     1.4 cm off its middle reached 3 mm past the opening from every posture of the grid that
@@ -198,10 +196,9 @@ def rank_drop_postures(
     the object as it falls (`falls`, TCP frame, m) over the opening, and none of it past the
     opening's back edge, toward the rider, each with its rank key, sorted. Wholly inside the
     opening: (0, 0, 0, fall, nearness); partly past it: (1, coarse fall, steps past, fall,
-    nearness). The fall is the object's lowest point over the
-    basket's floor in `fall_step` steps (coarse: `overhang_fall_step`), the reach past the
-    opening in `overhang_step` steps, and nearness the largest joint's distance from
-    `q_ref` (rad)."""
+    nearness). The fall is the object's lowest point over the basket's floor in `fall_step`
+    steps (coarse: `overhang_fall_step`), the reach past the opening in `overhang_step`
+    steps, and nearness the largest joint's distance from `q_ref` (rad)."""
     if not candidates:
         return []
     floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
