@@ -324,15 +324,16 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
 
 
 def test_a_drop_let_go_partly_past_the_basket_opening_asks_the_user_to_check() -> None:
-    """No posture holds a 24 cm box held at its top wholly over the basket's opening, so the
-    hand lets it go partly past it, and the user is asked to check: no camera sees the
-    basket, and a box let go so may lie across both its walls, in the way of the next carry.
-    The mug is what the hand holds; the drop is told it holds the box."""
+    """No posture holds a box 26 by 20 cm across, held at its top, wholly over the basket's
+    opening (18 by 30 cm, 1 cm in from the walls), so the hand lets it go partly past it, and
+    the user is asked to check: no camera sees the basket, and a box let go so may lie across
+    both its walls, in the way of the next carry. The mug is what the hand holds; the drop is
+    told it holds the box."""
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
         actor = Actor("bench")
         held = _mug_kept(session, actor)
-        box = np.mgrid[-0.095:0.0951:0.019, -0.03:0.0301:0.015, 0.0:0.2401:0.02].reshape(3, -1).T
+        box = np.mgrid[-0.13:0.1301:0.02, -0.1:0.1001:0.02, 0.0:0.1001:0.02].reshape(3, -1).T
         session.behaviours.held = dataclasses.replace(held, points_tcp=box)
         session.execute(actor)
         _wait(lambda: not session.busy, 120.0)
