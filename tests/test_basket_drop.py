@@ -12,7 +12,13 @@ import pytest
 from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, isolation_robot, pick_object
 from basket import assert_in_basket
 
-from laserpick.behaviours import Behaviours, basket_opening, drop_candidates, drop_configurations
+from laserpick.behaviours import (
+    Behaviours,
+    basket_opening,
+    drop_candidates,
+    drop_configurations,
+    rank_drop_postures,
+)
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -109,24 +115,39 @@ def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
 
 
-def test_a_tall_object_held_at_its_top_is_laid_over_the_basket():
-    """A 25 cm cereal box held at its top hangs too deep for a downward hand to hold it above
-    the basket's rim (the arm reaches 26 cm above it): no upright posture is clear, and a
-    tilted one holds its middle over the opening instead."""
+def test_a_tall_object_held_at_its_top_is_laid_into_the_basket():
+    """A 24 cm box held at its top hangs too deep for any upright posture of the fixed grid
+    (the arm reaches at most 26 cm above the rim pointing down): none is clear. Laid in, its
+    bottom 4 cm over the basket's floor, it is wholly over the opening, clear of the basket
+    and the steering column."""
     payload = box_points((0.19, 0.06, 0.24))
     free = CollisionChecker(np.zeros((0, 3)))
     upright = np.array(drop_candidates())
     assert not free.clearance_ok(upright, payload=payload).any()
     drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
-    assert drops, "a tilted posture holds it over the opening"
-    lo = dims.BASKET_CENTER[:2] - dims.BASKET_INNER[:2] / 2
-    hi = dims.BASKET_CENTER[:2] + dims.BASKET_INNER[:2] / 2
-    for q in drops[:3]:
-        T = tcp_pose(q)
-        held = payload @ T[:3, :3].T + T[:3, 3]
-        middle = held[:, :2].mean(axis=0)
-        assert np.all((middle > lo) & (middle < hi))
-        assert held[:, 2].min() > dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
+    assert len(drops) >= BEHAVIOUR.drop_tries
+    for q in drops[: BEHAVIOUR.drop_tries]:
+        past, fall = past_and_fall(q, payload)
+        assert past == 0 and fall == pytest.approx(min(BEHAVIOUR.drop_lows), abs=1e-6)
+        assert free.clearance_ok(q, payload=payload)[0]
+
+
+def test_a_box_held_off_its_middle_is_laid_wholly_into_the_basket():
+    """A cereal box (25 x 6 x 19 cm) held 1.4 cm off its middle, as the bookshelf's was: no
+    posture of the fixed grid holds it wholly over the opening (the grid places the hand,
+    not the box: each that turns it the right way holds it 3 mm past), and let go 6 cm past
+    a wall, it lay across the rims. Laid in by its own outline, it is wholly inside, 4 cm
+    over the floor; the steering column's keep-out takes only the column's corner of the
+    basket, not its back 6 cm."""
+    payload = box_points((0.25, 0.06, 0.19)) + [0.014, 0.0, 0.0]
+    free = CollisionChecker(np.zeros((0, 3)))
+    grid = [q for q in drop_candidates() if free.clearance_ok(q, payload=payload)[0]]
+    assert all(past_and_fall(q, payload)[0] > 0 for q in grid)
+    drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
+    assert len(drops) >= BEHAVIOUR.drop_tries
+    for q in drops[: BEHAVIOUR.drop_tries]:
+        past, fall = past_and_fall(q, payload)
+        assert past == 0 and fall < BEHAVIOUR.fall_step * 2
         assert free.clearance_ok(q, payload=payload)[0]
 
 
@@ -151,6 +172,20 @@ def test_postures_that_hold_an_object_partly_past_the_opening_rank_upright_and_t
     assert any(upright) and not upright[0], "a tilted posture before the upright ones"
 
 
+def test_nothing_is_let_go_reaching_past_the_back_wall_toward_the_rider():
+    """A box too large to be held wholly over the opening may be let go partly past its
+    front or its sides, never past its back edge: there are the tiller, the handlebars and
+    the rider's hands, where a cereal box let go partly past came to rest."""
+    payload = box_points((0.26, 0.20, 0.10))
+    free = CollisionChecker(np.zeros((0, 3)))
+    drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
+    assert drops and all(past_and_fall(q, payload)[0] > 0 for q in drops)
+    back_edge = basket_opening()[0][0]
+    for q in drops:
+        T = tcp_pose(q)
+        assert (payload @ T[:3, :3].T + T[:3, 3])[:, 0].min() >= back_edge
+
+
 def test_a_drop_holds_over_the_opening_the_object_as_seen_not_the_part_guessed_past_the_view():
     """A juice bottle lying on the 108 cm table, seen 9 cm of its 20.6 cm and held at the
     middle of that: the carry keeps clear a shape carried on past the view's edge to 25 cm
@@ -163,8 +198,9 @@ def test_a_drop_holds_over_the_opening_the_object_as_seen_not_the_part_guessed_p
     guessed = np.mgrid[0.055:0.2001:step, -0.035:0.0351:step, 0:0.0701:step].reshape(3, -1).T
     payload = np.vstack([seen, guessed])
     free = CollisionChecker(np.zeros((0, 3)))
-    as_guessed = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
-    assert past_and_fall(as_guessed[0], seen)[0] > 0
+    grid = drop_candidates()
+    as_guessed = rank_drop_postures(grid, dims.UR5_READY_Q, free, payload, payload, BEHAVIOUR)
+    assert past_and_fall(as_guessed[0][1], seen)[0] > 0
     drops = drop_configurations(dims.UR5_READY_Q, free, payload, seen, settings=BEHAVIOUR)
     assert len(drops) >= BEHAVIOUR.drop_tries
     for q in drops[: BEHAVIOUR.drop_tries]:

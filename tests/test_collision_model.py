@@ -24,6 +24,7 @@ from laserpick.pipeline.collision import (
     surface_front,
     thin,
 )
+from laserpick.pipeline.collision.keepout import box_gaps
 from laserpick.robot.sim.model import ModelInfo, build_sim_model
 
 
@@ -151,6 +152,28 @@ def test_the_clearance_a_posture_keeps_is_found_to_within_its_steps():
     assert far.clearance_kept(dims.UR5_READY_Q, hand=False) == 0.01
     inside = CollisionChecker(below[None] + [0.0, 0.0, 0.01], voxel=0.0, margin=0.01)
     assert inside.clearance_kept(dims.UR5_READY_Q, hand=False) is None
+
+
+def test_the_basket_is_kept_out_of_only_where_the_steering_column_passes_through_it():
+    """Inside the basket (a 1 cm grid, 5 mm in from its walls, above its floor's keep-out),
+    only the steering column's corner is kept out of: as one box round the tiller and the
+    handlebars, the keep-out took the back 6 cm of the basket's 20, and a cereal box in the
+    hand fitted nowhere inside. Over the rim, the handlebars' box still keeps the arm 12 cm
+    ahead of them, where the rider's hands are."""
+    lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2 + 0.005
+    hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2 - 0.005
+    grid = np.mgrid[lo[0] : hi[0] : 0.01, lo[1] : hi[1] : 0.01, lo[2] + 0.02 : hi[2] : 0.01]
+    points = grid.reshape(3, -1).T
+    inside = box_gaps(points) == 0
+    names = [b.name for b in KEEPOUT_BOXES]
+    kept = points[inside.any(axis=1)]
+    assert set(np.array(names)[inside.any(axis=0)]) == {"tiller_column"}
+    column_front = dims.TILLER_X + dims.TILLER_FOOT_AHEAD + dims.TILLER_RADIUS + 0.01
+    assert kept[:, 0].max() < column_front
+    assert np.abs(kept[:, 1]).max() <= dims.TILLER_RADIUS + 0.01
+    assert len(kept) < 0.03 * len(points)
+    over_rim = np.array([dims.TILLER_X + 0.085, 0.2, dims.BASKET_CENTER[2] + 0.1])
+    assert box_gaps(over_rim)[names.index("tiller_over_basket")] == 0
 
 
 def test_keepout_boxes_are_well_formed():

@@ -11,7 +11,7 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline.collision import CollisionChecker, held_at
+from laserpick.pipeline.collision import PAYLOAD_POINT_RADIUS, CollisionChecker, held_at
 from laserpick.settings import BehaviourSettings, get_settings
 from laserpick.transforms import roty, rotz
 
@@ -19,6 +19,7 @@ __all__ = [
     "basket_opening",
     "drop_candidates",
     "drop_configurations",
+    "laid_in_candidates",
     "past_the_opening",
     "rank_drop_postures",
 ]
@@ -46,10 +47,16 @@ def drop_candidates(
 
 
 @functools.cache
+def _scooter_only() -> CollisionChecker:
+    """A checker with no cloud: the arm against the scooter, its rider and itself."""
+    return CollisionChecker(np.zeros((0, 3)))
+
+
+@functools.cache
 def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarray, ...]:
     centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
     rim = centre[2] + inner[2] / 2
-    free = CollisionChecker(np.zeros((0, 3)))
+    free = _scooter_only()
     if tilted:
         offsets = np.linspace(-0.2, 0.2, 5)
         grid = itertools.product(
@@ -96,12 +103,16 @@ def drop_configurations(
     would pull the middle it is held by off the real object's, and let it fall beside the
     basket.
 
+    Where the grid holds too few wholly inside, the postures that lay this object in
+    (`laid_in_candidates`) are ranked with the tilted ones.
+
     Postures that hold every point of the object inside the opening (1 cm in from the
-    walls) come first, upright before tilted, each by the shortest fall (in `fall_step`
+    walls) come first, upright before laid in and tilted, each by the shortest fall (in `fall_step`
     steps: a long fall bounces the object out), then the nearest to q_ref. Then those
     that hold its middle there, upright and tilted together (`rank_drop_postures`).
     A posture that does not hold even the middle over the opening is left out: an object
-    let go there would fall beside the basket, onto the scooter or the floor. Empty when
+    let go there would fall beside the basket, onto the scooter or the floor. So is one that
+    holds any of it past the opening's back edge, over the tiller and the rider's hands. Empty when
     none is left.
     The basket sits close beside the arm's base, between the tiller, the sensor posts and
     the projector, so few postures reach over it: they are searched, not assumed.
@@ -110,12 +121,54 @@ def drop_configurations(
     upright = drop_candidates(heights=settings.drop_heights)
     ranked = rank_drop_postures(upright, q_ref, checker, payload, falls, settings)
     if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
+        held = np.vstack([payload, falls])
+        laid = laid_in_candidates(held, q_ref, settings.drop_lows, checker.margin)
         tilted = drop_candidates(tilted=True, heights=settings.drop_heights)
-        ranked += rank_drop_postures(tilted, q_ref, checker, payload, falls, settings)
+        for more in (laid, tilted):
+            ranked += rank_drop_postures(more, q_ref, checker, payload, falls, settings)
         inside = [kq for kq in ranked if kq[0][0] == 0]
         past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
         ranked = inside + past
     return [q for _, q in ranked]
+
+
+def laid_in_candidates(
+    held: np.ndarray, q_ref: np.ndarray, lows: Sequence[float], margin: float
+) -> list[np.ndarray]:
+    """Joint configurations (rad) that lay the held object (`held`, its points (P, 3) in
+    the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point
+    `lows` (m) over the basket's floor, its outline within the opening and `margin` (m, the
+    clearance the check keeps) off the walls, at the middle and at either side of the room
+    it has there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns whose
+    outline fits the opening are tried, and only configurations clear of the scooter are
+    kept (the object itself is checked when they are ranked).
+
+    The fixed grid of `drop_candidates` places the hand, not the object: a cereal box held
+    1.4 cm off its middle reached 3 mm past the opening from every posture of the grid that
+    turned it the right way, and was let go across the rims from higher up instead."""
+    if len(held) == 0:
+        return []
+    half = dims.BASKET_INNER[:2] / 2 - max(margin + PAYLOAD_POINT_RADIUS, 0.01)
+    lo, hi = dims.BASKET_CENTER[:2] - half, dims.BASKET_CENTER[:2] + half
+    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    free = _scooter_only()
+    out: list[np.ndarray] = []
+    for yaw, tilt in itertools.product(np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30))):
+        R = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down, then turned
+        turned = held @ R.T
+        low, high = turned.min(axis=0), turned.max(axis=0)
+        room = (hi - lo) - (high - low)[:2]
+        if (room < 0).any():
+            continue
+        # In whole cm, rounded down: a spot never reaches past the room it has.
+        spots = itertools.product(*(np.unique(np.floor([0, 50 * r, 100 * r]) / 100) for r in room))
+        for (sx, sy), above in itertools.product(spots, lows):
+            T = np.eye(4)
+            T[:3, :3] = R
+            T[:3, 3] = [lo[0] + sx - low[0], lo[1] + sy - low[1], floor + above - low[2]]
+            Q = ik_tcp(T, q_ref)
+            out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
+    return out
 
 
 def basket_opening() -> tuple[np.ndarray, np.ndarray]:
@@ -142,9 +195,10 @@ def rank_drop_postures(
     settings: BehaviourSettings,
 ) -> list[tuple[DropRank, np.ndarray]]:
     """The clear `candidates` (clear with `payload`, TCP frame, m) that hold the middle of
-    the object as it falls (`falls`, TCP frame, m) over the opening, each with its rank key,
-    sorted. Wholly inside the opening: (0, 0, 0, fall, nearness); partly past it: (1,
-    coarse fall, steps past, fall, nearness). The fall is the object's lowest point over the
+    the object as it falls (`falls`, TCP frame, m) over the opening, and none of it past the
+    opening's back edge, toward the rider, each with its rank key, sorted. Wholly inside the
+    opening: (0, 0, 0, fall, nearness); partly past it: (1, coarse fall, steps past, fall,
+    nearness). The fall is the object's lowest point over the
     basket's floor in `fall_step` steps (coarse: `overhang_fall_step`), the reach past the
     opening in `overhang_step` steps, and nearness the largest joint's distance from
     `q_ref` (rad)."""
@@ -155,8 +209,11 @@ def rank_drop_postures(
     T = tcp_pose(Q)
     pts = falls if len(falls) else np.zeros((1, 3))
     held = held_at(T, pts)  # (B, P, 3)
-    middle_in = past_the_opening(held.mean(axis=1)) == 0
-    Q, held = Q[middle_in], held[middle_in]
+    # Past the back wall are the tiller, the handlebars and the rider's hands: nothing is let
+    # go reaching over it: a cereal box let go near it came to rest on the handlebars.
+    rider_side = (basket_opening()[0][0] - held[..., 0]).max(axis=1) > 0
+    keep = (past_the_opening(held.mean(axis=1)) == 0) & ~rider_side
+    Q, held = Q[keep], held[keep]
     # In chunks: the check's arrays grow with candidates x payload points x spheres.
     clear = np.concatenate(
         [checker.clearance_ok(Q[i : i + 64], payload=payload) for i in range(0, len(Q), 64)]

@@ -158,7 +158,10 @@ CASTER_RADIUS = 0.08
 SEAT_X = 0.15
 SEAT_HEIGHT = 0.62  #: seat cushion top (m)
 SEAT_BACK_HEIGHT = 1.05
-TILLER_X = 0.86  #: steering column position (m)
+TILLER_X = 0.86  #: steering column position at the handlebars (m)
+#: The steering column leans back: its foot on the deck is this far ahead of its top (m).
+TILLER_FOOT_AHEAD = 0.04
+TILLER_RADIUS = 0.04
 HANDLEBAR_HEIGHT = 0.92
 HANDLEBAR_WIDTH = 0.55
 #: Basket on the handlebars: centre (m, base frame), inner size (m), wall thickness (m).

@@ -121,8 +121,11 @@ POST_BACK = 0.1
 #: arm's mount.
 PEDESTAL_RADIUS = 0.07
 PEDESTAL_FOOT = 0.15
-#: Clearance (m) the keep-out boxes add around the posts, the pedestal and the housings.
+#: Clearance (m) the keep-out boxes add around the posts, the pedestal, the housings and the
+#: steering column.
 HOUSING_PAD = 0.005
+#: How far forward (m, `base` x) the arm keeps from the rider's hands on the handlebars.
+TILLER_FRONT = dims.TILLER_X + 0.09
 
 
 def _housings() -> tuple[Housing, ...]:
@@ -147,6 +150,32 @@ def _housings() -> tuple[Housing, ...]:
 HOUSINGS: tuple[Housing, ...] = _housings()
 
 
+def _tiller(deck_top: float, basket_back: tuple[float, float], rim: float) -> tuple[Box, ...]:
+    """The tiller's and the handlebars' keep-out boxes. The rider's hands are on the
+    handlebars: the arm keeps 12 cm ahead of them (x to `TILLER_FRONT`) over the basket's rim
+    (`rim`, m) and beside the basket, and behind its back wall (`basket_back`: the back
+    wall's outer x and the right wall's outer y, m). Inside the basket, only the steering
+    column itself (a box along its lean): as one box, the tiller took the back 6 cm of the
+    basket's 20, and a cereal box held in the hand fitted nowhere inside."""
+    lo_x, hi_y = dims.TILLER_X - 0.08, dims.HANDLEBAR_WIDTH / 2 + 0.03
+    back_x, right_y = basket_back
+    top = dims.HANDLEBAR_HEIGHT + 0.04
+    foot = np.array([dims.TILLER_X + dims.TILLER_FOOT_AHEAD, 0.0, deck_top])
+    head = np.array([dims.TILLER_X, 0.0, dims.HANDLEBAR_HEIGHT])
+    axis = head - foot
+    R = roty(math.atan2(axis[0], axis[2]))  # the box's z along the column
+    middle = R.T @ ((foot + head) / 2)
+    half = np.array([dims.TILLER_RADIUS, dims.TILLER_RADIUS, np.linalg.norm(axis) / 2])
+    half += HOUSING_PAD
+    turn = tuple(tuple(float(v) for v in row) for row in R)
+    return (
+        Box("tiller", (lo_x, -hi_y, deck_top), (back_x, hi_y, top)),
+        Box("tiller_over_basket", (back_x, -hi_y, rim), (TILLER_FRONT, hi_y, top)),
+        Box("tiller_beside_basket", (back_x, -hi_y, deck_top), (TILLER_FRONT, right_y, rim)),
+        Box("tiller_column", tuple(middle - half), tuple(middle + half), turn=turn),
+    )
+
+
 def _keepout() -> tuple[Box, ...]:
     deck_top = dims.SCOOTER_DECK_HEIGHT
     x_rear = -dims.SCOOTER_REAR_OVERHANG
@@ -167,12 +196,7 @@ def _keepout() -> tuple[Box, ...]:
         Box("deck", (x_rear, -half_w, 0.0), (dims.CASTER_X + 0.1, half_w, deck_top)),
         # The rider, seated: a generous column from the seat back to in front of the knees.
         Box("rider", (x_rear - 0.1, -0.36, deck_top), (0.72, 0.36, 1.75)),
-        # Tiller and handlebars.
-        Box(
-            "tiller",
-            (dims.TILLER_X - 0.08, -dims.HANDLEBAR_WIDTH / 2 - 0.03, deck_top),
-            (dims.TILLER_X + 0.09, dims.HANDLEBAR_WIDTH / 2 + 0.03, dims.HANDLEBAR_HEIGHT + 0.04),
-        ),
+        *_tiller(deck_top, (bx0, by0), bz1),
         # The basket: its floor and four walls, open at the top for a drop.
         Box(
             "basket_floor",

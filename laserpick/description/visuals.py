@@ -122,7 +122,7 @@ def _box(name: str, half, pos, rgba: RGBA, R: np.ndarray | None = None) -> Shape
 
 
 def _seat_and_tiller() -> list[Shape]:
-    tiller_bottom = (dims.TILLER_X + 0.04, 0.0, dims.SCOOTER_DECK_HEIGHT)
+    tiller_bottom = (dims.TILLER_X + dims.TILLER_FOOT_AHEAD, 0.0, dims.SCOOTER_DECK_HEIGHT)
     tiller_top = (dims.TILLER_X, 0.0, dims.HANDLEBAR_HEIGHT)
     half, bar_x, bar_z = dims.HANDLEBAR_WIDTH / 2, dims.TILLER_X - 0.03, dims.HANDLEBAR_HEIGHT
     return [
@@ -138,7 +138,7 @@ def _seat_and_tiller() -> list[Shape]:
             (dims.SEAT_X - 0.2, 0, dims.SEAT_BACK_HEIGHT - 0.2),
             DARK_RGBA,
         ),
-        _capsule("scooter/tiller", tiller_bottom, tiller_top, 0.04, SCOOTER_RGBA),
+        _capsule("scooter/tiller", tiller_bottom, tiller_top, dims.TILLER_RADIUS, SCOOTER_RGBA),
         _capsule(
             "scooter/handlebar", (bar_x, half, bar_z), (bar_x, -half, bar_z), 0.018, DARK_RGBA
         ),

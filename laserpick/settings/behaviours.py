@@ -73,6 +73,13 @@ class BehaviourSettings(BaseModel):
         " objects, the high ones for a tall object held near its top, which hangs deep below"
         " the hand. Ours.",
     )
+    drop_lows: tuple[float, ...] = Field(
+        (0.04, 0.08),
+        description="Heights (m) of a held object's lowest point over the basket's floor where"
+        " the arm lays it in (`laid_in_candidates`), when too few postures of the fixed grid"
+        " hold it wholly over the opening: 4 cm keeps the object's 1 cm points and the 1 cm"
+        " clearance off the floor's 1.3 cm keep-out. Ours.",
+    )
     drop_tries: int = Field(
         3,
         ge=1,
