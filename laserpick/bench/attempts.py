@@ -24,6 +24,9 @@ class Attempt:
     strategy: str
     task: int = 0  #: which task of the trial: the tries at one object share it
     marks: int = 0  #: marks made (re-marks after a missed dot count)
+    #: m the user backed the scooter up within this try, as the robot asked before the arm
+    #: moved (`Failure.back_up`), and marked again from there
+    backed_up: float = 0.0
     places: int = 0  #: place marks confirmed (pick and place)
     detected: bool = False  #: the grasp chosen (or executed) was on the marked object
     #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)

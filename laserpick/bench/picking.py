@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -111,6 +112,10 @@ class ScriptedOperator:
         self._unplanned: dict[str, list[np.ndarray]] = {}
         #: The look the user aimed their last mark by (None: they aimed at a given point).
         self._view: View | None = None
+        #: How the user backs the scooter up straight by so many m from where they parked for
+        #: the task, and whether they parked there: the protocols that drive set it for each
+        #: task (None: the user stays where they are).
+        self.back_up: Callable[[float], bool] | None = None
         self._events: list[dict[str, Any]] = []
         # Stamped with the simulated time as they happen (listeners run on the emitting thread).
         session.on_event(lambda e: self._events.append({**e, "sim_time": self._sim_time()}))
@@ -217,6 +222,17 @@ class ScriptedOperator:
                 return True
             failure = s.failure or Failure("execute", f"the session rests {s.state.value}")
             rec.fail(failure.kind, failure.message)
+            asked = failure.back_up if on is not None and not rec.backed_up else None
+            if asked is not None and self.back_up is not None:
+                # The robot asked the user to back up before the arm moved: they do, once a
+                # try, as a person told so would, and mark again from there.
+                s.cancel(BENCH)
+                rec.backed_up = asked
+                self._view = self.referee.view() if self.back_up(asked) else None
+                aim = None if self._view is None else self._view.top(rec.instance)
+                if aim is None:  # could not park there, or no camera sees it from there
+                    return False
+                continue
             if s.state != TaskState.AIMING:  # found the object, but no grasp: not the aim
                 break
         s.cancel(BENCH)

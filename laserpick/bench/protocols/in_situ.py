@@ -4,8 +4,8 @@ to each object's surface and tries until the object is in the basket (at most MA
 from __future__ import annotations
 
 from laserpick.bench.attempts import Attempt
-from laserpick.bench.parking import NO_PARKING, go_to_object
-from laserpick.bench.protocols.retries import MAX_TRIES, next_try, still_there
+from laserpick.bench.parking import NO_PARKING
+from laserpick.bench.protocols.retries import MAX_TRIES, TaskSpot, still_there
 from laserpick.bench.protocols.trials import (
     Options,
     instances,
@@ -25,8 +25,8 @@ def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
     with scripted_operator(scene, trial, seed, opt) as op:
         names = shuffled(op, instances(scene))[:IN_SITU_OBJECTS]
         for task, name in enumerate(limit(names, opt)):
-            back = across = 0.0
-            parked = go_to_object(op, scene, name)
+            spot = TaskSpot(op, scene, name)
+            parked = spot.go()
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 rec.task = task
@@ -39,6 +39,6 @@ def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
                 if rec.success or not still_there(op, name, stood):
                     break
                 if rec.failure == "ik_plan":
-                    back, across = next_try(rec, back, across, scene)
-                    parked = go_to_object(op, scene, name, back, across)
+                    spot.after(rec)
+                    parked = spot.go()
     return out

@@ -14,10 +14,10 @@ import numpy as np
 import yaml
 
 from laserpick.bench.attempts import Attempt
-from laserpick.bench.parking import NO_PARKING, go_to_object, park
+from laserpick.bench.parking import NO_PARKING, park
 from laserpick.bench.picking import Placed, ScriptedOperator
 from laserpick.bench.protocols.place_spots import aim_as_told, aims_in_sight, free_spot, room_for
-from laserpick.bench.protocols.retries import MAX_TRIES, next_try, still_there
+from laserpick.bench.protocols.retries import MAX_TRIES, TaskSpot, still_there
 from laserpick.bench.protocols.trials import (
     Options,
     instances,
@@ -50,16 +50,16 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
     with scripted_operator(scene, trial, seed, opt) as op:
         for task, name in enumerate(limit(shuffled(op, instances(scene)), opt)):
             op.begin_task(task)
-            back = across = 0.0
+            spot = TaskSpot(op, scene, name)
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 rec.task = task
                 stood = op.referee.world_position(name)
-                out.append(_move_object(op, scene, rec, back, across))
+                out.append(_move_object(op, scene, rec, spot))
                 op.tidy()
                 if rec.success or rec.message == NO_PARKING or not still_there(op, name, stood):
                     break
-                back, across = next_try(rec, back, across, scene)
+                spot.after(rec)
     return out
 
 
@@ -130,13 +130,11 @@ def set_down_error(
     return float(np.linalg.norm(referee.body_point(instance, anchor)[:2] - hit[:2] - offset))
 
 
-def _move_object(
-    op: ScriptedOperator, scene: Scene, rec: Attempt, back: float = 0.0, across: float = 0.0
-) -> Attempt:
-    """One 004 section 8.3 attempt: pick `rec.instance`, parked as `go_to_object` parks
-    (`back`, `across`), and set it down on another surface."""
+def _move_object(op: ScriptedOperator, scene: Scene, rec: Attempt, spot: TaskSpot) -> Attempt:
+    """One 004 section 8.3 attempt: pick `rec.instance`, parked at the task's `spot`, and set
+    it down on another surface."""
     session, referee = op.session, op.referee
-    if not go_to_object(op, scene, rec.instance, back, across):
+    if not spot.go():
         return rec.fail("precondition", NO_PARKING)
     session.set_mode(op.actor, mode="pick_and_place")
     quat_before = referee.world_quat(rec.instance)

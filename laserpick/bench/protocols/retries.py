@@ -1,11 +1,14 @@
 """When the scripted user tries an object again (in-situ and pick-place), and where they park
-for the next try."""
+for each try."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from laserpick.bench.attempts import Attempt
+from laserpick.bench.parking import go_to_object
 from laserpick.bench.picking import ScriptedOperator
 from laserpick.pipeline.grasp_choice import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import Scene
@@ -43,6 +46,35 @@ def next_try(rec: Attempt, back: float, across: float, scene: Scene) -> tuple[fl
     if not shelf and UNSEEN_WAYS in (rec.message or "") and across == 0.0:
         return back, IN_VIEW_ACROSS
     return back + RETRY_BACK, across
+
+
+@dataclass
+class TaskSpot:
+    """Where the user parks for one task's tries: `back` m farther back than at first and
+    `across` m to the arm's left (as in `go_to_object`). Made for a task, it is also how the
+    user backs up when the robot asks (`ScriptedOperator.back_up`)."""
+
+    op: ScriptedOperator
+    scene: Scene
+    instance: str
+    back: float = 0.0
+    across: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.op.back_up = self.back_up
+
+    def go(self) -> bool:
+        """Drive there; whether the user parked."""
+        return go_to_object(self.op, self.scene, self.instance, self.back, self.across)
+
+    def back_up(self, distance: float) -> bool:
+        """Park `distance` m farther back, as the robot asked; whether the user parked."""
+        self.back += distance
+        return self.go()
+
+    def after(self, rec: Attempt) -> None:
+        """Where the next try parks after `rec` (`next_try`)."""
+        self.back, self.across = next_try(rec, self.back, self.across, self.scene)
 
 
 def still_there(op: ScriptedOperator, name: str, stood: np.ndarray) -> bool:
