@@ -44,7 +44,7 @@ def test_losses_that_differ_only_in_numbers_and_names_are_one_family(tmp_path: P
             _record(0, 1, "spice_jar", NO_POSTURE.format(n=3)),  # first try lost...
             _record(0, 1, "spice_jar"),  # ...recovered by the second
             _record(0, 2, "glass_cup", GLASS, failure="precondition", surface="counter"),
-            _record(0, 3, "mug"),
+            _record(0, 3, "mug", backed_up=0.1),  # done after backing up as asked
         ],
     )
     b = _write(
@@ -66,6 +66,8 @@ def test_losses_that_differ_only_in_numbers_and_names_are_one_family(tmp_path: P
     assert sweep.task_rates(["glass_cup"]) == (4, 3, 2)
     text = format_sweep(sweep, ["glass_cup"])
     assert "| without glass_cup | 4 | 3 (75.0 %) | 2 (50.0 %) |" in text
+    assert sweep.backed_up() == (1, 1)
+    assert "backed up as the robot asked, before the arm moved: 1 (1 of them done)" in text
 
 
 def test_a_surface_kind_drops_its_number() -> None:
