@@ -1,10 +1,14 @@
 """The robot's advice to back up (`laserpick.pipeline.parking_advice`): the least step back
-from which the arm can take a grasp it cannot take from here, or none."""
+from which the arm can take a grasp it cannot take from here, or none; and the scripted user,
+who backs up as asked within the try."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from laserpick.bench.protocols import PROTOCOLS, Options
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_READY_Q
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import unreachable
@@ -81,3 +85,23 @@ def test_the_sentence_and_the_failure_carry_the_advice() -> None:
     assert "Back up about 10 cm and mark it again" in failure.message
     plain = unreachable(12, "the arm cannot reach this grasp", None)
     assert plain.back_up is None and "Back up" not in plain.message
+
+
+def test_the_user_backs_up_as_asked_and_the_first_try_takes_the_object(tmp_path: Path) -> None:
+    """A pill bottle lying on the bookshelf's middle board, the board above it 31 cm up:
+    parked where the user parks, every posture of every grasp brings the forearm down onto
+    that board, and the robot asks them to back up before the arm moves. They do, within the
+    try, and mark again: the object is in the basket at the first try, the attempt records
+    how far they backed up. (A user who does not listen loses the first try.)"""
+    scene = tmp_path / "shelf.yaml"
+    scene.write_text(
+        "name: shelf\nscooter: {x: -1.2, y: 0.9, yaw_deg: 90}\nsurfaces:\n"
+        "  - {name: bookshelf, kind: shelf, xy: [-1.20, 2.45], yaw_deg: 90, size: [0.30, 0.80],"
+        " levels: [0.05, 0.38, 0.69, 1.00]}\n"
+        "objects:\n  - {name: pill_bottle, model: pill_bottle, on: bookshelf, level: 2,"
+        " xy: [-1.05, 2.40], lying: true}\n"
+    )
+    (rec,) = PROTOCOLS["in-situ"].run(0, 1, Options(selection="manual", scene=str(scene)))
+    assert rec.success, rec.message
+    assert rec.backed_up in BACK_UP_STEPS
+    assert rec.marks >= 2  # the mark the robot answered with its advice, and the one after
