@@ -56,6 +56,14 @@ def side_pose(x: float, y: float, z: float) -> np.ndarray:
     return T
 
 
+def box_points(size: tuple[float, float, float], step: float = 0.01) -> np.ndarray:
+    """Points (m) filling a box of `size` whose top face's middle is the origin, reaching
+    down along +z: a box held at its top by a downward hand, in the TCP frame."""
+    axes = [np.arange(-s / 2, s / 2 + 1e-9, step) for s in size[:2]]
+    axes.append(np.arange(0.0, size[2] + 1e-9, step))
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
 def pick_object(robot: SimRobot, name: str, from_above: bool = False) -> tuple[Behaviours, Referee]:
     """Perceive the object at its aim point, find its grasps and pick it, as a session does.
     from_above: try the grasps from above first (each group in score order), for scenes

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, isolation_robot, pick_object
+from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, box_points, isolation_robot, pick_object
 from basket import assert_in_basket
 
 from laserpick.behaviours import (
@@ -32,14 +32,6 @@ from laserpick.robot.sim.scenes import load_scene
 @pytest.fixture
 def robot():
     yield from isolation_robot()
-
-
-def box_points(size: tuple[float, float, float], step: float = 0.01) -> np.ndarray:
-    """Points (m) filling a box of `size` whose top face's middle is the origin, reaching
-    down along +z: a box held at its top by a downward hand, in the TCP frame."""
-    axes = [np.arange(-s / 2, s / 2 + 1e-9, step) for s in size[:2]]
-    axes.append(np.arange(0.0, size[2] + 1e-9, step))
-    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
 def past_and_fall(q: np.ndarray, payload: np.ndarray) -> tuple[int, float]:

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from arm_setups import box_points
 from driving import drive_straight
 
 from laserpick.behaviours import PAST_THE_OPENING, Held, Outcome
@@ -333,7 +334,7 @@ def test_a_drop_let_go_partly_past_the_basket_opening_asks_the_user_to_check() -
     try:
         actor = Actor("bench")
         held = _mug_kept(session, actor)
-        box = np.mgrid[-0.13:0.1301:0.02, -0.1:0.1001:0.02, 0.0:0.1001:0.02].reshape(3, -1).T
+        box = box_points((0.26, 0.20, 0.10), step=0.02)
         session.behaviours.held = dataclasses.replace(held, points_tcp=box)
         session.execute(actor)
         _wait(lambda: not session.busy, 120.0)
