@@ -35,6 +35,7 @@ RESULT_PACKAGES = (
     "daqp",
     "pin",
     "ur-analytic-ik",
+    "ompl",
 )
 
 
