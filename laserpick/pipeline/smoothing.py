@@ -22,6 +22,7 @@ The path parameter s (rad) is arc length along the straight parts; along a blend
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Callable, Sequence
@@ -64,10 +65,14 @@ class BlendedPath:
     def length(self) -> float:
         return float(self.poly.x[-1])
 
+    @functools.cached_property
+    def _orders(self) -> list[BPoly]:
+        return [self.poly, *(self.poly.derivative(k) for k in (1, 2, 3))]
+
     def __call__(self, s: np.ndarray | float, order: int = 0) -> np.ndarray:
-        """q (rad) or its order-th derivative with respect to s at path positions s."""
-        f = self.poly if order == 0 else self.poly.derivative(order)
-        return f(np.clip(s, 0.0, self.length))
+        """q (rad) or its order-th derivative (order <= 3) with respect to s at path
+        positions s."""
+        return self._orders[order](np.clip(s, 0.0, self.length))
 
 
 def _control_points(p: np.ndarray, u1: np.ndarray, u2: np.ndarray, d: float) -> np.ndarray:
@@ -76,26 +81,43 @@ def _control_points(p: np.ndarray, u1: np.ndarray, u2: np.ndarray, d: float) -> 
     return p[None, :] + (_CONTROL * d)[:, None] * legs
 
 
+def _bernstein(degree: int, tau: np.ndarray) -> np.ndarray:
+    """(len(tau), degree + 1) Bernstein basis polynomials of `degree` at tau in [0, 1]."""
+    k = np.arange(degree + 1)
+    binom = np.array([math.comb(degree, i) for i in k], float)
+    return binom * tau[:, None] ** k * (1.0 - tau[:, None]) ** (degree - k)
+
+
+#: The blend's points and its second and third derivatives (per unit tau) at _SAMPLES
+#: points, as matrices on its control points (a quintic: 20 and 60 times the second and
+#: third differences of its control points, on the cubic and quadratic bases).
+_TAU = np.linspace(0.0, 1.0, _SAMPLES)
+_AT, _BEND, _TWIST = _bernstein(5, _TAU), 20.0 * _bernstein(3, _TAU), 60.0 * _bernstein(2, _TAU)
+
+
 def _unit_blend(u1: np.ndarray, u2: np.ndarray) -> tuple[float, float, float]:
-    """For the blend with d = 1 at a corner at the origin: its largest distance from the
-    legs, and the largest |q''| and |q'''| of any joint along it, per unit path."""
-    curve = BPoly(_control_points(np.zeros(6), u1, u2, 1.0)[:, None, :], [0.0, 2.0])
-    s = np.linspace(0.0, 2.0, _SAMPLES)
-    pts = curve(s)
+    """For the blend with d = 1 at a corner at the origin (2 rad of path long): its largest
+    distance from the legs, and the largest |q''| and |q'''| of any joint along it, per unit
+    path."""
+    ctrl = _control_points(np.zeros(6), u1, u2, 1.0)
+    pts = _AT @ ctrl
     gaps = []
     for u in (-u1, u2):  # each leg as a ray from the corner, of length 1
         along = np.clip(pts @ u, 0.0, 1.0)
         gaps.append(np.linalg.norm(pts - along[:, None] * u[None, :], axis=1))
-    bend = np.abs(curve.derivative(2)(s)).max()
-    twist = np.abs(curve.derivative(3)(s)).max()
+    bend = np.abs(_BEND @ np.diff(ctrl, 2, axis=0)).max() / 2.0**2  # d/ds = d/dtau / 2
+    twist = np.abs(_TWIST @ np.diff(ctrl, 3, axis=0)).max() / 2.0**3
     return float(np.max(np.minimum(*gaps))), float(bend), float(twist)
 
 
 def _blend_samples(p: np.ndarray, u1: np.ndarray, u2: np.ndarray, d: float) -> np.ndarray:
-    """Configurations along the blend, no more than CHECK_STEP apart in any joint."""
+    """Configurations along the blend, no more than CHECK_STEP apart in any joint: a
+    quintic moves no joint faster per unit tau than 5 times its control points' largest
+    step in that joint."""
     ctrl = _control_points(p, u1, u2, d)
-    n = max(2, math.ceil(2.0 * d / CHECK_STEP) + 1)
-    return BPoly(ctrl[:, None, :], [0.0, 1.0])(np.linspace(0.0, 1.0, n))
+    rate = 5.0 * float(np.abs(np.diff(ctrl, axis=0)).max())
+    n = max(2, math.ceil(rate / CHECK_STEP) + 1)
+    return _bernstein(5, np.linspace(0.0, 1.0, n)) @ ctrl
 
 
 @dataclass(frozen=True)
@@ -165,10 +187,17 @@ def _reach(
 
 def _both(a: ClearFn | None, b: ClearFn | None) -> ClearFn | None:
     """The check a blend between legs checked by a and b must pass: both (None if either
-    leg has no check)."""
-    if a is None or b is None or a is b:
-        return None if a is None or b is None else a
-    return lambda Q: a(Q) & b(Q)
+    leg has no check); b is asked only where a passes every configuration."""
+    if a is None or b is None:
+        return None
+    if a is b:
+        return a
+
+    def both(Q: np.ndarray) -> np.ndarray:
+        first = a(Q)
+        return first & b(Q) if first.all() else first
+
+    return both
 
 
 def corners(

@@ -88,11 +88,11 @@ class _Path(toppra.interpolator.AbstractGeometricPath):
     """A `BlendedPath` as TOPP-RA reads a path."""
 
     def __init__(self, path: BlendedPath) -> None:
-        self._orders = [path.poly, path.poly.derivative(1), path.poly.derivative(2)]
+        self._path = path
         self._interval = np.array([0.0, path.length])
 
     def __call__(self, path_positions, order: int = 0) -> np.ndarray:
-        return self._orders[order](path_positions)
+        return self._path(path_positions, order)
 
     @property
     def dof(self) -> int:
