@@ -23,6 +23,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import GRIPPER_CAPSULES
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
+from laserpick.pipeline.plan_record import record_search
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.smoothing import ClearFn
 from laserpick.pipeline.timing import Limits, time_parametrize
@@ -172,6 +173,7 @@ def joint_path(
         return np.array([q_start, q_goal], float)
     if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
         return None
+    record_search(q_start, q_goal, checker, kw)
     path = rrt_connect(
         q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
     )

@@ -1,0 +1,136 @@
+"""Our RRT-Connect against OMPL's, side by side on recorded joint-space search problems.
+
+Record problems by running any bench with LASERPICK_RECORD_PLANS set: every search that
+`plan.joint_path` starts (the straight move blocked, both ends clear) is saved as one .npz
+(`laserpick.pipeline.plan_record`). Then each planner solves each problem once per seed,
+in turn (so both meet the same machine load), with the motion settings' sample budget:
+
+- ours: `plan.rrt_connect` (extension step `rrt_step`, largest joint) and `plan.shortcut`;
+- ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker).
+
+Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s)
+and the joint-space path length (rad, summed Euclidean norm of the steps; median and mean
+over the problems both solved), and checks every returned path again at the checker's
+resolution (`CollisionChecker.segment_ok`).
+
+    LASERPICK_RECORD_PLANS=/tmp/plans/in-situ .venv/bin/laserpick bench --protocol in-situ \
+        --seed 2 --trials 1 --out /tmp/in-situ.json
+    .venv/bin/python bench/planners.py /tmp/plans/in-situ [/tmp/plans/...] [--seeds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.ompl_search import OMPL_RANGE, ompl_connect
+from laserpick.pipeline.plan import rrt_connect, shortcut
+from laserpick.pipeline.plan_record import load_search
+from laserpick.settings import MotionSettings, get_settings
+
+Planner = Callable[
+    [np.ndarray, np.ndarray, CollisionChecker, np.random.Generator, MotionSettings, dict],
+    np.ndarray | None,
+]
+
+
+def ours(q0, q1, checker, rng, s, kw):
+    path = rrt_connect(q0, q1, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw)
+    return None if path is None else shortcut(path, checker, rng, **kw)
+
+
+def ompl_with(search_range: float, shortcuts: bool = True) -> Planner:
+    def ompl(q0, q1, checker, rng, s, kw):
+        return ompl_connect(
+            q0,
+            q1,
+            checker,
+            rng,
+            max_samples=s.rrt_max_samples,
+            search_range=search_range,
+            shortcuts=shortcuts,
+            **kw,
+        )
+
+    return ompl
+
+
+def length(path: np.ndarray) -> float:
+    """Joint-space length (rad): the summed Euclidean norms of the path's steps."""
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+
+
+def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str, list]:
+    """Each planner on each problem and seed: rows (problem, seed, found, seconds, length,
+    clear), planners taking turns on each problem."""
+    s = get_settings().motion
+    rows: dict[str, list] = {name: [] for name in planners}
+    for k, f in enumerate(files):
+        q0, q1, checker, kw = load_search(f)
+        for seed, (name, plan) in itertools.product(range(seeds), planners.items()):
+            t = time.perf_counter()
+            path = plan(q0, q1, checker, np.random.default_rng(seed), s, kw)
+            dt = time.perf_counter() - t
+            found = path is not None
+            clear = found and all(
+                checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(path)
+            )
+            rows[name].append((k, seed, found, dt, length(path) if found else np.nan, clear))
+        print(f"{f.name}: " + ", ".join(f"{n} {rows[n][-1][3]:.2f} s" for n in planners))
+    return rows
+
+
+def report(rows: dict[str, list]) -> None:
+    """The comparison as a Markdown table."""
+    both = np.logical_and.reduce([np.array([x[2] for x in r]) for r in rows.values()])
+    print(
+        "\n| planner | solved | time median (s) | mean (s) | p90 (s) | length median (rad) |"
+        " mean (rad) | paths clear |"
+    )
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for name, r in rows.items():
+        found = np.array([x[2] for x in r])
+        dt = np.array([x[3] for x in r])
+        lengths = np.array([x[4] for x in r])[both]
+        clear = sum(x[5] for x in r)
+        print(
+            f"| {name} | {found.sum()}/{len(r)} ({100 * found.mean():.0f}%) "
+            f"| {np.median(dt):.3f} | {dt.mean():.3f} | {np.percentile(dt, 90):.3f} "
+            f"| {np.median(lengths):.2f} | {lengths.mean():.2f} | {clear}/{found.sum()} |"
+        )
+    print(f"\nlengths over the {both.sum()} runs that every planner solved")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folders", nargs="+", type=Path, help="folders of recorded .npz problems")
+    ap.add_argument("--seeds", type=int, default=3, help="runs of each planner per problem")
+    ap.add_argument(
+        "--ranges",
+        type=float,
+        nargs="*",
+        default=[OMPL_RANGE],
+        help="OMPL RRT-Connect extension steps (rad, Euclidean) to compare",
+    )
+    ap.add_argument(
+        "--no-shortcuts", action="store_true", help="also OMPL without partialShortcutPath"
+    )
+    args = ap.parse_args()
+    files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
+    planners: dict[str, Planner] = {"ours": ours}
+    for r in args.ranges:
+        planners[f"ompl (range {r:.2f})"] = ompl_with(r)
+        if args.no_shortcuts:
+            planners[f"ompl (range {r:.2f}, no shortcuts)"] = ompl_with(r, shortcuts=False)
+    print(f"{len(files)} problems, {args.seeds} seeds each")
+    report(run(files, planners, args.seeds))
+
+
+if __name__ == "__main__":
+    main()

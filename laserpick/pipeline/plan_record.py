@@ -1,0 +1,86 @@
+"""Joint-space search problems saved for replay: with LASERPICK_RECORD_PLANS=DIR set, every
+search `plan.joint_path` starts (the straight move was blocked, both ends clear) is written
+to DIR as one .npz: the start and goal (rad), the collision checker's inputs (its cloud in
+`base`, m; margin and floor clearance, m; the depth frames and the arm's own space of its
+seen-space test) and the check's options. `bench/planners.py` replays them with each search.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numpy as np
+
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.collision.seen_space import OwnSpace
+from laserpick.types import DepthFrame
+
+#: The environment variable naming the folder problems are written to; unset: none are.
+RECORD_ENV = "LASERPICK_RECORD_PLANS"
+#: The checker options a problem keeps (`CollisionChecker.clearance_ok`'s keywords).
+OPTIONS = ("hand", "seen", "payload", "margin")
+
+
+def record_search(
+    q_start: np.ndarray, q_goal: np.ndarray, checker: CollisionChecker, kw: dict
+) -> Path | None:
+    """Write the search from q_start to q_goal (6,) (rad) with `checker` and its options `kw`
+    to $LASERPICK_RECORD_PLANS, named by a hash of its content (the same problem met twice is
+    kept once). Returns the file, or None when recording is off."""
+    folder = os.environ.get(RECORD_ENV)
+    if not folder:
+        return None
+    arrays = {
+        "q_start": np.asarray(q_start, float),
+        "q_goal": np.asarray(q_goal, float),
+        "points": checker.points,
+        "margin": np.float64(checker.margin),
+        "floor_clearance": np.float64(checker.floor_clearance),
+        "own_centres": checker._own.centres,
+        "own_reach": checker._own.reach,
+    }
+    for k, f in enumerate(checker.frames):
+        arrays |= {f"depth_{k}": f.depth, f"K_{k}": f.K, f"T_{k}": f.T_base_cam}
+    for name in OPTIONS:
+        if kw.get(name) is not None:
+            arrays[f"opt_{name}"] = np.asarray(kw[name])
+    digest = hashlib.sha1()
+    for name in sorted(arrays):
+        digest.update(name.encode() + np.ascontiguousarray(arrays[name]).tobytes())
+    path = Path(folder) / f"{digest.hexdigest()[:16]}.npz"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists():
+        np.savez_compressed(path, **arrays)
+    return path
+
+
+def load_search(path: str | Path) -> tuple[np.ndarray, np.ndarray, CollisionChecker, dict]:
+    """A problem `record_search` wrote: (q_start, q_goal, checker, kw) as they were."""
+    data = np.load(path)
+    frames = []
+    k = 0
+    while f"depth_{k}" in data:
+        frames.append(
+            DepthFrame(
+                depth=data[f"depth_{k}"],
+                ir=np.zeros((0, 0), np.uint8),
+                K=data[f"K_{k}"],
+                T_base_cam=data[f"T_{k}"],
+                camera=f"recorded_{k}",
+                stamp=0.0,
+            )
+        )
+        k += 1
+    checker = CollisionChecker(
+        data["points"], margin=float(data["margin"]), filtered=True, frames=frames
+    )
+    checker.floor_clearance = float(data["floor_clearance"])
+    checker._own = OwnSpace(data["own_centres"], data["own_reach"])
+    kw = {}
+    for name in OPTIONS:
+        if f"opt_{name}" in data:
+            value = data[f"opt_{name}"]
+            kw[name] = value.item() if value.ndim == 0 else value
+    return data["q_start"], data["q_goal"], checker, kw
