@@ -10,8 +10,9 @@ in turn (so both meet the same machine load), with the motion settings' sample b
 
 Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s)
 and the joint-space path length (rad, summed Euclidean norm of the steps; median and mean
-over the problems both solved), and checks every returned path again at the checker's
-resolution (`CollisionChecker.segment_ok`).
+over the problems both solved), the configurations the search asked the collision checker
+about (mean: its work, which the machine's load does not change), and checks every returned
+path again at the checker's resolution (`CollisionChecker.segment_ok`).
 
     LASERPICK_RECORD_PLANS=/tmp/plans/in-situ .venv/bin/laserpick bench --protocol in-situ \
         --seed 2 --trials 1 --out /tmp/in-situ.json
@@ -66,23 +67,41 @@ def length(path: np.ndarray) -> float:
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
+def counting(checker: CollisionChecker) -> list[int]:
+    """Count the configurations `checker` is asked about (a measure of a search's work that,
+    unlike its wall-clock time, does not depend on the machine's load)."""
+    checked = [0]
+    clearance_ok = checker.clearance_ok
+
+    def counted(Q, **kw):
+        checked[0] += len(np.atleast_2d(Q))
+        return clearance_ok(Q, **kw)
+
+    checker.clearance_ok = counted  # type: ignore[method-assign]
+    return checked
+
+
 def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str, list]:
     """Each planner on each problem and seed: rows (problem, seed, found, seconds, length,
-    clear), planners taking turns on each problem."""
+    clear, configurations checked), planners taking turns on each problem."""
     s = get_settings().motion
     rows: dict[str, list] = {name: [] for name in planners}
     for k, f in enumerate(files):
         q0, q1, checker, kw = load_search(f)
+        checked = counting(checker)
         for seed, (name, plan) in itertools.product(range(seeds), planners.items()):
+            checked[0] = 0
             t = time.perf_counter()
             path = plan(q0, q1, checker, np.random.default_rng(seed), s, kw)
             dt = time.perf_counter() - t
+            n = checked[0]
             found = path is not None
             clear = found and all(
                 checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(path)
             )
-            rows[name].append((k, seed, found, dt, length(path) if found else np.nan, clear))
-        print(f"{f.name}: " + ", ".join(f"{n} {rows[n][-1][3]:.2f} s" for n in planners))
+            rows[name].append((k, seed, found, dt, length(path) if found else np.nan, clear, n))
+        line = ", ".join(f"{n} {rows[n][-1][3]:.2f} s {rows[n][-1][6]} q" for n in planners)
+        print(f"{f.name}: {line}", flush=True)
     return rows
 
 
@@ -91,9 +110,9 @@ def report(rows: dict[str, list]) -> None:
     both = np.logical_and.reduce([np.array([x[2] for x in r]) for r in rows.values()])
     print(
         "\n| planner | solved | time median (s) | mean (s) | p90 (s) | length median (rad) |"
-        " mean (rad) | paths clear |"
+        " mean (rad) | configurations checked, mean | paths clear |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, r in rows.items():
         found = np.array([x[2] for x in r])
         dt = np.array([x[3] for x in r])
@@ -102,7 +121,8 @@ def report(rows: dict[str, list]) -> None:
         print(
             f"| {name} | {found.sum()}/{len(r)} ({100 * found.mean():.0f}%) "
             f"| {np.median(dt):.3f} | {dt.mean():.3f} | {np.percentile(dt, 90):.3f} "
-            f"| {np.median(lengths):.2f} | {lengths.mean():.2f} | {clear}/{found.sum()} |"
+            f"| {np.median(lengths):.2f} | {lengths.mean():.2f} "
+            f"| {np.mean([x[6] for x in r]):.0f} | {clear}/{found.sum()} |"
         )
     print(f"\nlengths over the {both.sum()} runs that every planner solved")
 

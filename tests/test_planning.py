@@ -24,7 +24,6 @@ from laserpick.pipeline.plan import (
     cartesian_line,
     joint_path,
     plan_pick,
-    rrt_connect,
     shortcut,
     straight_lift,
     transit_path,
@@ -115,38 +114,74 @@ def test_cartesian_line_is_straight():
     assert np.allclose(tcp_pose(path[-1]), T1, atol=1e-6)
 
 
-def test_rrt_connect_goes_around_a_wall_and_every_step_is_clear():
-    rng = np.random.default_rng(0)
+def _wall_between() -> tuple[np.ndarray, np.ndarray, CollisionChecker]:
+    """Two hands over the table with a wall of points between them, from the table up to
+    0.8 m: both ends clear, the straight joint move through the wall."""
     q0 = ik_tcp(top_grasp(1.6, -0.5, 0.65), dims.UR5_READY_Q)[0]
     q1 = ik_tcp(top_grasp(1.6, 0.1, 0.65), dims.UR5_READY_Q)[0]
-    # A wall of points between the two, from the table up to 0.8 m.
     wall = np.array(
         [[x, -0.2, z] for x in np.arange(1.45, 1.75, 0.02) for z in np.arange(0.46, 0.8, 0.02)]
     )
-    checker = CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
+    return q0, q1, CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
+
+
+def _mould(q_in: np.ndarray, q_out: np.ndarray, gap: float = 0.01) -> np.ndarray:
+    """Points (m, `base`) on spheres `gap` beyond the clearance of each of the arm's spheres
+    at q_in (rad), every 1.5 cm, less those within half the gap of the arm at q_in or at
+    q_out: a mould the arm stands clear in at q_in, and cannot leave."""
+    margin, spacing = CollisionChecker(EMPTY).margin, 0.015
+    inside = sphere_centres(body_frames(q_in))[0]
+    outside = sphere_centres(body_frames(q_out))[0]
+    shells = []
+    for c, r in zip(inside, SPHERES.radius, strict=True):
+        R = r + margin + gap
+        k = np.arange(max(20, int(4 * np.pi * R * R / spacing**2))) + 0.5  # a Fibonacci sphere
+        polar, around = np.arccos(1 - 2 * k / len(k)), np.pi * (1 + 5**0.5) * k
+        ray = np.c_[np.cos(around) * np.sin(polar), np.sin(around) * np.sin(polar), np.cos(polar)]
+        shells.append(c + R * ray)
+    points = np.vstack(shells)
+    for centres in (inside, outside):
+        d = np.linalg.norm(points[:, None] - centres[None], axis=2)
+        points = points[(d > SPHERES.radius + margin + gap / 2).all(axis=1)]
+    return points
+
+
+@pytest.mark.parametrize("planner", ["ompl", "ours"])
+def test_joint_path_goes_around_a_wall_and_every_step_is_clear(planner):
+    q0, q1, checker = _wall_between()
     assert checker.clearance_ok(np.stack([q0, q1])).all()
     assert not checker.segment_ok(q0, q1)
-    path = rrt_connect(q0, q1, checker, rng, step=0.3, max_samples=3000)
-    assert path is not None
-    assert np.allclose(path[0], q0) and np.allclose(path[-1], q1)
-    assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
-    short = shortcut(path, checker, rng)
-    assert len(short) <= len(path)
-    assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(short))
-    via = joint_path(q0, q1, checker, rng, get_settings().motion)
-    assert via is not None and len(via) > 2
+    s = get_settings().motion.model_copy(update={"planner": planner})
+    for seed in range(3):
+        path = joint_path(q0, q1, checker, np.random.default_rng(seed), s)
+        assert path is not None and len(path) > 2
+        assert np.array_equal(path[0], q0) and np.array_equal(path[-1], q1)
+        assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
+        again = joint_path(q0, q1, checker, np.random.default_rng(seed), s)
+        assert np.array_equal(path, again), "the same seed gives the same path"
+
+
+@pytest.mark.parametrize("planner", ["ompl", "ours"])
+def test_joint_path_says_none_where_the_goal_is_walled_in(planner):
+    """The arm at the goal stands clear inside a mould of points that leaves it no way out:
+    the search runs (both ends clear, the straight move blocked) and finds nothing."""
+    goal = ik_tcp(top_grasp(1.6, -0.5, 0.65), dims.UR5_READY_Q)[0]
+    start = goal + np.array([1.2, 0, 0, 0, 0, 0])  # the base turned away
+    checker = CollisionChecker(_mould(goal, start), voxel=0.0)
+    assert checker.clearance_ok(np.stack([start, goal])).all()
+    assert not checker.segment_ok(start, goal)
+    s = get_settings().motion.model_copy(update={"planner": planner, "rrt_max_samples": 200})
+    assert joint_path(start, goal, checker, np.random.default_rng(0), s) is None
+    # Without the mould the same move is the straight one.
+    open_space = CollisionChecker(EMPTY)
+    assert len(joint_path(start, goal, open_space, np.random.default_rng(0), s)) == 2
 
 
 def test_shortcut_does_not_check_a_blocked_join_twice():
     """Once the only joins left are blocked, the shortcut stops: it spent its 60 tries
     re-checking one blocked join of a three-point path (170 ms of a 220 ms plan)."""
-    q0 = ik_tcp(top_grasp(1.6, -0.5, 0.65), dims.UR5_READY_Q)[0]
-    q1 = ik_tcp(top_grasp(1.6, 0.1, 0.65), dims.UR5_READY_Q)[0]
+    q0, q1, checker = _wall_between()
     mid = ik_tcp(top_grasp(1.6, -0.2, 0.95), dims.UR5_READY_Q)[0]
-    wall = np.array(
-        [[x, -0.2, z] for x in np.arange(1.45, 1.75, 0.02) for z in np.arange(0.46, 0.8, 0.02)]
-    )
-    checker = CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
     assert not checker.segment_ok(q0, q1)
     calls: list[tuple[bytes, bytes]] = []
     segment_ok = checker.segment_ok

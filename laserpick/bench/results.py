@@ -36,6 +36,7 @@ RESULT_PACKAGES = (
     "pin",
     "ur-analytic-ik",
     "toppra",
+    "ompl",
 )
 
 

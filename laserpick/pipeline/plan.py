@@ -2,9 +2,10 @@
 
 Straight lines first: a straight joint-space move when it is clear, and straight Cartesian
 lines for the approach and the lift. When a joint-space move collides, RRT-Connect (Kuffner
-and LaValle 2000) searches around the obstacle, and the path is shortened by random
-shortcuts. Every path is checked against a `CollisionChecker`, then time-parametrized within
-the joint speed, joint acceleration and TCP speed limits of `MotionSettings`.
+and LaValle 2000) searches around the obstacle: OMPL's, shortened by OMPL's path simplifier
+(`ompl_search`), or ours, shortened by random shortcuts (`MotionSettings.planner`). Every
+path is checked against a `CollisionChecker`, then time-parametrized within the joint speed,
+joint acceleration and TCP speed limits of `MotionSettings`.
 
 Frames: TCP poses in `base` (m); joint angles in rad.
 """
@@ -23,6 +24,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import GRIPPER_CAPSULES
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
+from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.smoothing import ClearFn
@@ -166,7 +168,8 @@ def joint_path(
     s: MotionSettings,
     **kw,
 ) -> np.ndarray | None:
-    """A clear joint path: the straight one if clear, else RRT-Connect, shortened. None at
+    """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: OMPL's or
+    ours), shortened. None at
     once when the start or the goal is not clear: no edge can leave it, and the search would
     spend all its samples (seconds) finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
@@ -174,6 +177,9 @@ def joint_path(
     if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
         return None
     record_search(q_start, q_goal, checker, kw)
+    if s.planner == "ompl":
+        budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
+        return ompl_connect(q_start, q_goal, checker, rng, **budget, **kw)
     path = rrt_connect(
         q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, Field, model_validator
 
 __all__ = ["ApproachSettings", "MotionSettings"]
@@ -103,7 +105,21 @@ class MotionSettings(BaseModel):
     rrt_max_samples: int = Field(
         2000, ge=10, description="Samples before the joint-space planner gives up."
     )
-    rrt_step: float = Field(0.3, gt=0, description="RRT-Connect extension step (rad).")
+    rrt_step: float = Field(
+        0.3, gt=0, description="RRT-Connect extension step (rad, largest joint; ours)."
+    )
+    planner: Literal["ompl", "ours"] = Field(
+        "ompl",
+        description="The joint-space search: OMPL's RRT-Connect and path simplifier, or our"
+        " RRT-Connect with random shortcuts; both ask our collision check"
+        " (docs/pipeline.md compares them on recorded problems).",
+    )
+    search_time: float = Field(
+        30.0,
+        gt=0,
+        description="Wall-clock cap (s) of one OMPL search, on top of its rrt_max_samples:"
+        " only a machine far slower than the bench's meets it (it would make runs differ).",
+    )
     rrt_max_failed: int = Field(
         6,
         ge=1,
