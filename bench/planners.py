@@ -46,7 +46,7 @@ def ours(q0, q1, checker, rng, s, kw):
     return None if path is None else shortcut(path, checker, rng, **kw)
 
 
-def ompl_with(search_range: float, shortcuts: bool = True) -> Planner:
+def ompl_with(search_range: float) -> Planner:
     def ompl(q0, q1, checker, rng, s, kw):
         return ompl_connect(
             q0,
@@ -55,7 +55,6 @@ def ompl_with(search_range: float, shortcuts: bool = True) -> Planner:
             rng,
             max_samples=s.rrt_max_samples,
             search_range=search_range,
-            shortcuts=shortcuts,
             **kw,
         )
 
@@ -138,16 +137,11 @@ def main() -> None:
         default=[OMPL_RANGE],
         help="OMPL RRT-Connect extension steps (rad, Euclidean) to compare",
     )
-    ap.add_argument(
-        "--no-shortcuts", action="store_true", help="also OMPL without partialShortcutPath"
-    )
     args = ap.parse_args()
     files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
     planners: dict[str, Planner] = {"ours": ours}
     for r in args.ranges:
         planners[f"ompl (range {r:.2f})"] = ompl_with(r)
-        if args.no_shortcuts:
-            planners[f"ompl (range {r:.2f}, no shortcuts)"] = ompl_with(r, shortcuts=False)
     print(f"{len(files)} problems, {args.seeds} seeds each")
     report(run(files, planners, args.seeds))
 

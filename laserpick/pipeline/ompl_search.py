@@ -106,15 +106,19 @@ def _reseed(seed: int) -> None:
     ou.setLogLevel(level)
 
 
-def _simplify(si, path, shortcuts: bool) -> None:
-    """OMPL's shortening, in the order its `simplify` takes: shortcuts between points on the
-    path's edges (`shortcuts`), fewer vertices, close vertices merged, fewer vertices again."""
+def _simplify(si, path) -> None:
+    """OMPL's shortening: fewer vertices (joins between the path's vertices), shortcuts
+    between points on its edges, fewer vertices again."""
     simplifier = og.PathSimplifier(si)
-    if shortcuts:
-        simplifier.partialShortcutPath(path)
     simplifier.reduceVertices(path)
-    simplifier.collapseCloseVertices(path)
+    simplifier.partialShortcutPath(path)
     simplifier.reduceVertices(path)
+
+
+def _waypoints(path, q_start: np.ndarray, q_goal: np.ndarray) -> np.ndarray:
+    out = np.array([_as_q(path.getState(i)) for i in range(path.getStateCount())])
+    out[0], out[-1] = q_start, q_goal
+    return out
 
 
 def ompl_connect(
@@ -126,7 +130,6 @@ def ompl_connect(
     max_samples: int = 2000,
     time_budget: float = 30.0,
     search_range: float = OMPL_RANGE,
-    shortcuts: bool = True,
     **kw,
 ) -> np.ndarray | None:
     """A clear, shortened joint path (K, 6) rad from q_start to q_goal, or None when RRT-Connect
@@ -154,10 +157,14 @@ def ompl_connect(
     status = planner.solve(ob.PlannerTerminationCondition(spent))
     if status.getStatus() != ob.PlannerStatus.EXACT_SOLUTION:
         return None
-    path = problem.getSolutionPath()
-    _simplify(si, path, shortcuts)
-    out = np.array([_as_q(path.getState(i)) for i in range(path.getStateCount())])
-    out[0], out[-1] = q_start, q_goal
-    if not all(validator.ok(a, b) for a, b in itertools.pairwise(out)):
-        return None
-    return out
+    found = problem.getSolutionPath()
+    path = og.PathGeometric(found)
+    _simplify(si, path)
+    # A shortcut from a point inside an edge leaves the rest of that edge, which the checker
+    # saw only at the edge's own steps: checked at its own, it may touch. The path as found
+    # was checked edge by edge as it stands.
+    for candidate in (path, found):
+        out = _waypoints(candidate, q_start, q_goal)
+        if all(validator.ok(a, b) for a, b in itertools.pairwise(out)):
+            return out
+    return None
