@@ -8,9 +8,10 @@ in turn (so both meet the same machine load), with the motion settings' sample b
 - ours: `plan.rrt_connect` (extension step `rrt_step`, largest joint) and `plan.shortcut`;
 - ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker).
 
-Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s)
-and the joint-space path length (rad, summed Euclidean norm of the steps; median and mean
-over the problems both solved), the configurations the search asked the collision checker
+Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s),
+the joint-space path length (rad, summed Euclidean norm of the steps; median and mean over
+the problems both solved) and its largest-joint sweep (what bounds its time at the joint
+speed limit), the configurations the search asked the collision checker
 about (mean: its work, which the machine's load does not change), and checks every returned
 path again at the checker's resolution (`CollisionChecker.segment_ok`).
 
@@ -66,6 +67,12 @@ def length(path: np.ndarray) -> float:
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
+def sweep(path: np.ndarray) -> float:
+    """The summed largest joint motion of the path's steps (rad): at the joint speed limit,
+    the time the path takes is at least this over the limit."""
+    return float(np.abs(np.diff(path, axis=0)).max(axis=1).sum())
+
+
 def counting(checker: CollisionChecker) -> list[int]:
     """Count the configurations `checker` is asked about (a measure of a search's work that,
     unlike its wall-clock time, does not depend on the machine's load)."""
@@ -82,7 +89,7 @@ def counting(checker: CollisionChecker) -> list[int]:
 
 def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str, list]:
     """Each planner on each problem and seed: rows (problem, seed, found, seconds, length,
-    clear, configurations checked), planners taking turns on each problem."""
+    sweep, clear, configurations checked), planners taking turns on each problem."""
     s = get_settings().motion
     rows: dict[str, list] = {name: [] for name in planners}
     for k, f in enumerate(files):
@@ -98,8 +105,9 @@ def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str
             clear = found and all(
                 checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(path)
             )
-            rows[name].append((k, seed, found, dt, length(path) if found else np.nan, clear, n))
-        line = ", ".join(f"{n} {rows[n][-1][3]:.2f} s {rows[n][-1][6]} q" for n in planners)
+            lengths = (length(path), sweep(path)) if found else (np.nan, np.nan)
+            rows[name].append((k, seed, found, dt, *lengths, clear, n))
+        line = ", ".join(f"{n} {rows[n][-1][3]:.2f} s {rows[n][-1][7]} q" for n in planners)
         print(f"{f.name}: {line}", flush=True)
     return rows
 
@@ -109,19 +117,21 @@ def report(rows: dict[str, list]) -> None:
     both = np.logical_and.reduce([np.array([x[2] for x in r]) for r in rows.values()])
     print(
         "\n| planner | solved | time median (s) | mean (s) | p90 (s) | length median (rad) |"
-        " mean (rad) | configurations checked, mean | paths clear |"
+        " mean (rad) | largest-joint sweep, mean (rad) | configurations checked, mean |"
+        " paths clear |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("|" + " --- |" * 10)
     for name, r in rows.items():
         found = np.array([x[2] for x in r])
         dt = np.array([x[3] for x in r])
         lengths = np.array([x[4] for x in r])[both]
-        clear = sum(x[5] for x in r)
+        sweeps = np.array([x[5] for x in r])[both]
+        clear = sum(x[6] for x in r)
         print(
             f"| {name} | {found.sum()}/{len(r)} ({100 * found.mean():.0f}%) "
             f"| {np.median(dt):.3f} | {dt.mean():.3f} | {np.percentile(dt, 90):.3f} "
-            f"| {np.median(lengths):.2f} | {lengths.mean():.2f} "
-            f"| {np.mean([x[6] for x in r]):.0f} | {clear}/{found.sum()} |"
+            f"| {np.median(lengths):.2f} | {lengths.mean():.2f} | {sweeps.mean():.2f} "
+            f"| {np.mean([x[7] for x in r]):.0f} | {clear}/{found.sum()} |"
         )
     print(f"\nlengths over the {both.sum()} runs that every planner solved")
 
