@@ -128,7 +128,7 @@ def ompl_connect(
     rng: np.random.Generator,
     *,
     max_samples: int = 2000,
-    time_budget: float = 30.0,
+    time_budget: float = 60.0,
     search_range: float = OMPL_RANGE,
     **kw,
 ) -> np.ndarray | None:
