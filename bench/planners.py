@@ -5,7 +5,7 @@ Record problems by running any bench with LASERPICK_RECORD_PLANS set: every sear
 (`laserpick.pipeline.plan_record`). Then each planner solves each problem once per seed,
 in turn (so both meet the same machine load), with the motion settings' sample budget:
 
-- ours: `plan.rrt_connect` (extension step `rrt_step`, largest joint) and `plan.shortcut`;
+- ours: `rrt.rrt_connect` (extension step `rrt_step`, largest joint) and `rrt.shortcut`;
 - ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker).
 
 Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s),
@@ -32,8 +32,8 @@ import numpy as np
 
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.ompl_search import OMPL_RANGE, ompl_connect
-from laserpick.pipeline.plan import rrt_connect, shortcut
 from laserpick.pipeline.plan_record import load_search
+from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import MotionSettings, get_settings
 
 Planner = Callable[

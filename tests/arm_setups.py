@@ -15,8 +15,8 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.perceive import perceive
-from laserpick.pipeline.plan import cartesian_line
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.settings import get_settings

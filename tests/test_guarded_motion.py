@@ -12,7 +12,8 @@ from laserpick.behaviours import Behaviours
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import timed
 from laserpick.robot.sim.loop import DRIVE_STOP
 from laserpick.types import Trajectory
 

@@ -23,7 +23,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CARRIED_PADDING, CollisionChecker, carried_shape
 from laserpick.pipeline.grasp_choice import GraspSet
-from laserpick.pipeline.plan import cartesian_line
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.selection import group, score
 from laserpick.types import Grasp
 

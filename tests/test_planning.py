@@ -19,16 +19,16 @@ from laserpick.pipeline.collision import (
     held_clear_of_arm,
     sphere_centres,
 )
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import (
     Searches,
-    cartesian_line,
     joint_path,
     plan_pick,
-    shortcut,
     straight_lift,
     transit_path,
 )
 from laserpick.pipeline.reach import pregrasp_pose, reachable
+from laserpick.pipeline.rrt import shortcut
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 

@@ -12,7 +12,7 @@ from laserpick.description import dims
 from laserpick.description import kinematics as K
 from laserpick.description.shapes import body_frames
 from laserpick.pipeline.collision.arm_spheres import sphere_centres
-from laserpick.pipeline.plan import cartesian_line
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.timing import Limits, excess, time_parametrize
 from laserpick.settings import get_settings
 

@@ -13,7 +13,8 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried
-from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import timed
 from laserpick.types import Failure
 
 __all__ = ["Carrying", "holding_pose", "without_leftovers"]

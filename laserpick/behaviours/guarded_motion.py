@@ -17,7 +17,8 @@ from laserpick.behaviours.hand import GRIPPER_TIME
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.outcome import Outcome
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.plan import cartesian_line, joint_path, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import joint_path, timed
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure, Trajectory

@@ -10,7 +10,8 @@ from laserpick.behaviours.hand import pad_force, peak_pad_force
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import timed
 from laserpick.types import Failure, Trajectory
 
 __all__ = ["Leaving"]

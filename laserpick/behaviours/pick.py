@@ -15,7 +15,8 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasp_choice import GraspSet, plan_first
-from laserpick.pipeline.plan import PickPlan, cartesian_line, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import PickPlan, timed
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.types import Failure, Grasp, Trajectory
 

@@ -14,7 +14,7 @@ from laserpick.behaviours.messages import crowded_message
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker, obstacle_mask, surface_front
-from laserpick.pipeline.plan import cartesian_line
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.surface import SURFACE_BAND, on_floor
 from laserpick.settings import Settings
 from laserpick.transforms import rotz

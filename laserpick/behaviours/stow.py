@@ -10,7 +10,8 @@ from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import at_pose
-from laserpick.pipeline.plan import cartesian_line, timed
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.plan import timed
 
 __all__ = ["Stowing"]
 

@@ -15,8 +15,9 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.gpd import detect_grasps
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps, plan_first
 from laserpick.pipeline.laser_spots import detect_mark
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.perceive import Perception, perceive
-from laserpick.pipeline.plan import PickPlan, cartesian_line, joint_path, plan_pick, timed
+from laserpick.pipeline.plan import PickPlan, joint_path, plan_pick, timed
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled, ViewMemory

@@ -12,7 +12,6 @@ for a machine far slower than the bench's). Frames: joint angles in rad.
 from __future__ import annotations
 
 import itertools
-import math
 import time
 
 import numpy as np
@@ -20,10 +19,10 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from laserpick.description import dims
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.rrt import search_bounds
 
-__all__ = ["OMPL_RANGE", "ompl_connect", "search_bounds"]
+__all__ = ["OMPL_RANGE", "ompl_connect"]
 
 #: RRT-Connect's extension step (rad, Euclidean in joint space): on the recorded problems
 #: (bench/planners.py) 0.5 solved as many as 0.73 and 1.0 in less time.
@@ -32,14 +31,6 @@ OMPL_RANGE = 0.5
 _SEED_BOUND = 2**31 - 1
 
 ou.setLogLevel(ou.LogLevel.LOG_WARN)
-
-
-def search_bounds(q_start: np.ndarray, q_goal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The box (lo, hi) (6,) rad that samples are drawn from: the joint limits, within a half
-    turn of the box around start and goal (a way around an obstacle needs no more)."""
-    lo = np.maximum(dims.UR5_Q_MIN, np.minimum(q_start, q_goal) - math.pi)
-    hi = np.minimum(dims.UR5_Q_MAX, np.maximum(q_start, q_goal) + math.pi)
-    return lo, hi
 
 
 def _as_q(state) -> np.ndarray:

@@ -1,9 +1,10 @@
 """Motion planning for picks and places (paper 004 section 7.4).
 
 Straight lines first: a straight joint-space move when it is clear, and straight Cartesian
-lines for the approach and the lift. When a joint-space move collides, RRT-Connect (Kuffner
-and LaValle 2000) searches around the obstacle: OMPL's, shortened by OMPL's path simplifier
-(`ompl_search`), or ours, shortened by random shortcuts (`MotionSettings.planner`). Every
+lines (`lines`) for the approach and the lift. When a joint-space move collides,
+RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: OMPL's, shortened by
+OMPL's path simplifier (`ompl_search`), or ours, shortened by random shortcuts (`rrt`;
+`MotionSettings.planner`). Every
 path is checked against a `CollisionChecker`, then time-parametrized within the joint speed,
 joint acceleration and TCP speed limits of `MotionSettings`.
 
@@ -13,28 +14,25 @@ Frames: TCP poses in `base` (m); joint angles in rad.
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import GRIPPER_CAPSULES
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
+from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
+from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.pipeline.smoothing import ClearFn
 from laserpick.pipeline.timing import Limits, time_parametrize
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Trajectory
 
-#: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
-#: step means the IK jumped branches (a singularity), so the line is not followed.
-CARTESIAN_JUMP = 0.25
 #: How far (m) the hand's spheres may overlap surrounding points at the grasp: the finger
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
@@ -47,119 +45,6 @@ BLIND_LEGS = 3
 HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
 
 
-def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
-    """Pose a fraction s of the way from Ta to Tb: linear in position, slerp in rotation."""
-    rots = Rotation.from_matrix(np.stack([Ta[:3, :3], Tb[:3, :3]]))
-    T = np.eye(4)
-    T[:3, :3] = Slerp([0.0, 1.0], rots)(s).as_matrix()
-    T[:3, 3] = (1 - s) * Ta[:3, 3] + s * Tb[:3, 3]
-    return T
-
-
-def cartesian_line(
-    q_start: np.ndarray, T_goal: np.ndarray, step: float = 0.01
-) -> np.ndarray | None:
-    """Joint waypoints (K, 6) moving the TCP in a straight line from where q_start (6,) puts
-    it to T_goal, every `step` m; None where IK fails or jumps branches on the way."""
-    T_start = tcp_pose(q_start)
-    dist = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
-    n = max(2, math.ceil(dist / step) + 1)
-    path = [np.asarray(q_start, float)]
-    for s in np.linspace(0.0, 1.0, n)[1:]:
-        sols = ik_tcp(_lerp_pose(T_start, T_goal, float(s)), path[-1])
-        if len(sols) == 0 or np.max(np.abs(sols[0] - path[-1])) > CARTESIAN_JUMP:
-            return None
-        path.append(sols[0])
-    return np.array(path)
-
-
-def shortcut(
-    path: np.ndarray, checker: CollisionChecker, rng: np.random.Generator, tries: int = 60, **kw
-) -> np.ndarray:
-    """Shorten a joint path by joining random pairs of its points where the join is clear.
-
-    A join found blocked is not checked again; the search ends early when every join left
-    has been."""
-    points = [np.asarray(q) for q in path]
-    keep = list(range(len(points)))  # indices into `points` of the path so far
-    blocked: set[tuple[int, int]] = set()
-    for _ in range(tries):
-        if len(keep) < 3:
-            break
-        joins = (len(keep) - 1) * (len(keep) - 2) // 2  # pairs with a point between them
-        on_path = set(keep)
-        if sum(a in on_path and b in on_path for a, b in blocked) >= joins:
-            break
-        i, j = sorted(rng.choice(len(keep), size=2, replace=False))
-        pair = (keep[i], keep[j])
-        if j - i < 2 or pair in blocked:
-            continue
-        if checker.segment_ok(points[pair[0]], points[pair[1]], **kw):
-            keep = keep[: i + 1] + keep[j:]
-        else:
-            blocked.add(pair)
-    return np.array([points[k] for k in keep])
-
-
-def rrt_connect(
-    q_start: np.ndarray,
-    q_goal: np.ndarray,
-    checker: CollisionChecker,
-    rng: np.random.Generator,
-    *,
-    step: float = 0.3,
-    max_samples: int = 2000,
-    **kw,
-) -> np.ndarray | None:
-    """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
-
-    Two trees grow toward random samples within the joint limits and toward each other, in
-    steps of at most `step` rad (largest joint); each new edge is collision-checked.
-    """
-    lo = np.maximum(dims.UR5_Q_MIN, np.minimum(q_start, q_goal) - math.pi)
-    hi = np.minimum(dims.UR5_Q_MAX, np.maximum(q_start, q_goal) + math.pi)
-    trees = [([np.asarray(q_start, float)], [-1]), ([np.asarray(q_goal, float)], [-1])]
-
-    def extend(tree, target: np.ndarray) -> tuple[str, int]:
-        nodes, parents = tree
-        near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
-        delta = target - nodes[near]
-        span = float(np.max(np.abs(delta)))
-        reached = span <= step
-        q_new = target if reached else nodes[near] + delta * (step / span)
-        if not checker.segment_ok(nodes[near], q_new, **kw):
-            return "trapped", near
-        nodes.append(q_new)
-        parents.append(near)
-        return ("reached" if reached else "advanced"), len(nodes) - 1
-
-    def branch(tree, index: int) -> list[np.ndarray]:
-        nodes, parents = tree
-        out = []
-        while index >= 0:
-            out.append(nodes[index])
-            index = parents[index]
-        return out
-
-    for _ in range(max_samples):
-        q_rand = rng.uniform(lo, hi)
-        status, a = extend(trees[0], q_rand)
-        if status != "trapped":
-            q_new = trees[0][0][a]
-            while True:  # connect: the other tree steps toward q_new until blocked or there
-                status, b = extend(trees[1], q_new)
-                if status != "advanced":
-                    break
-            if status == "reached":
-                half_a, half_b = branch(trees[0], a), branch(trees[1], b)
-                path = half_a[::-1] + half_b[1:]
-                if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
-                    path = path[::-1]
-                return np.array(path)
-        trees.reverse()
-    return None
-
-
 def joint_path(
     q_start: np.ndarray,
     q_goal: np.ndarray,
@@ -169,9 +54,8 @@ def joint_path(
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: OMPL's or
-    ours), shortened. None at
-    once when the start or the goal is not clear: no edge can leave it, and the search would
-    spend all its samples (seconds) finding that out."""
+    ours), shortened. None at once when the start or the goal is not clear: no edge can
+    leave it, and the search would spend all its samples (seconds) finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
         return np.array([q_start, q_goal], float)
     if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():

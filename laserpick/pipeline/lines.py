@@ -1,0 +1,46 @@
+"""Straight lines of the hand: joint waypoints that move the TCP in a straight line, its
+orientation turned evenly on the way (the approach, the lifts, the rises and descents).
+
+Frames: TCP poses in `base` (m); joint angles in rad.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from laserpick.description.kinematics import ik_tcp, tcp_pose
+
+__all__ = ["CARTESIAN_JUMP", "cartesian_line"]
+
+#: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
+#: step means the IK jumped branches (a singularity), so the line is not followed.
+CARTESIAN_JUMP = 0.25
+
+
+def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
+    """Pose a fraction s of the way from Ta to Tb: linear in position, slerp in rotation."""
+    rots = Rotation.from_matrix(np.stack([Ta[:3, :3], Tb[:3, :3]]))
+    T = np.eye(4)
+    T[:3, :3] = Slerp([0.0, 1.0], rots)(s).as_matrix()
+    T[:3, 3] = (1 - s) * Ta[:3, 3] + s * Tb[:3, 3]
+    return T
+
+
+def cartesian_line(
+    q_start: np.ndarray, T_goal: np.ndarray, step: float = 0.01
+) -> np.ndarray | None:
+    """Joint waypoints (K, 6) moving the TCP in a straight line from where q_start (6,) puts
+    it to T_goal, every `step` m; None where IK fails or jumps branches on the way."""
+    T_start = tcp_pose(q_start)
+    dist = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
+    n = max(2, math.ceil(dist / step) + 1)
+    path = [np.asarray(q_start, float)]
+    for s in np.linspace(0.0, 1.0, n)[1:]:
+        sols = ik_tcp(_lerp_pose(T_start, T_goal, float(s)), path[-1])
+        if len(sols) == 0 or np.max(np.abs(sols[0] - path[-1])) > CARTESIAN_JUMP:
+            return None
+        path.append(sols[0])
+    return np.array(path)

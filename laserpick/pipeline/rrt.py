@@ -1,0 +1,111 @@
+"""Our joint-space search: RRT-Connect (Kuffner and LaValle 2000) with random shortcuts, kept
+beside OMPL's (`ompl_search`, the default) to rerun the comparison of the two
+(`bench/planners.py`), and the box of joint angles both draw their samples from.
+
+Frames: joint angles in rad.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from laserpick.description import dims
+from laserpick.pipeline.collision import CollisionChecker
+
+__all__ = ["rrt_connect", "search_bounds", "shortcut"]
+
+
+def search_bounds(q_start: np.ndarray, q_goal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The box (lo, hi) (6,) rad that samples are drawn from: the joint limits, within a half
+    turn of the box around start and goal (a way around an obstacle needs no more)."""
+    lo = np.maximum(dims.UR5_Q_MIN, np.minimum(q_start, q_goal) - math.pi)
+    hi = np.minimum(dims.UR5_Q_MAX, np.maximum(q_start, q_goal) + math.pi)
+    return lo, hi
+
+
+def shortcut(
+    path: np.ndarray, checker: CollisionChecker, rng: np.random.Generator, tries: int = 60, **kw
+) -> np.ndarray:
+    """Shorten a joint path by joining random pairs of its points where the join is clear.
+
+    A join found blocked is not checked again; the search ends early when every join left
+    has been."""
+    points = [np.asarray(q) for q in path]
+    keep = list(range(len(points)))  # indices into `points` of the path so far
+    blocked: set[tuple[int, int]] = set()
+    for _ in range(tries):
+        if len(keep) < 3:
+            break
+        joins = (len(keep) - 1) * (len(keep) - 2) // 2  # pairs with a point between them
+        on_path = set(keep)
+        if sum(a in on_path and b in on_path for a, b in blocked) >= joins:
+            break
+        i, j = sorted(rng.choice(len(keep), size=2, replace=False))
+        pair = (keep[i], keep[j])
+        if j - i < 2 or pair in blocked:
+            continue
+        if checker.segment_ok(points[pair[0]], points[pair[1]], **kw):
+            keep = keep[: i + 1] + keep[j:]
+        else:
+            blocked.add(pair)
+    return np.array([points[k] for k in keep])
+
+
+def rrt_connect(
+    q_start: np.ndarray,
+    q_goal: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    *,
+    step: float = 0.3,
+    max_samples: int = 2000,
+    **kw,
+) -> np.ndarray | None:
+    """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
+
+    Two trees grow toward random samples within the joint limits and toward each other, in
+    steps of at most `step` rad (largest joint); each new edge is collision-checked.
+    """
+    lo, hi = search_bounds(q_start, q_goal)
+    trees = [([np.asarray(q_start, float)], [-1]), ([np.asarray(q_goal, float)], [-1])]
+
+    def extend(tree, target: np.ndarray) -> tuple[str, int]:
+        nodes, parents = tree
+        near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
+        delta = target - nodes[near]
+        span = float(np.max(np.abs(delta)))
+        reached = span <= step
+        q_new = target if reached else nodes[near] + delta * (step / span)
+        if not checker.segment_ok(nodes[near], q_new, **kw):
+            return "trapped", near
+        nodes.append(q_new)
+        parents.append(near)
+        return ("reached" if reached else "advanced"), len(nodes) - 1
+
+    def branch(tree, index: int) -> list[np.ndarray]:
+        nodes, parents = tree
+        out = []
+        while index >= 0:
+            out.append(nodes[index])
+            index = parents[index]
+        return out
+
+    for _ in range(max_samples):
+        q_rand = rng.uniform(lo, hi)
+        status, a = extend(trees[0], q_rand)
+        if status != "trapped":
+            q_new = trees[0][0][a]
+            while True:  # connect: the other tree steps toward q_new until blocked or there
+                status, b = extend(trees[1], q_new)
+                if status != "advanced":
+                    break
+            if status == "reached":
+                half_a, half_b = branch(trees[0], a), branch(trees[1], b)
+                path = half_a[::-1] + half_b[1:]
+                if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
+                    path = path[::-1]
+                return np.array(path)
+        trees.reverse()
+    return None
