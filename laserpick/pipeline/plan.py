@@ -2,8 +2,8 @@
 
 Straight lines first: a straight joint-space move when it is clear, and straight Cartesian
 lines (`lines`) for the approach and the lift. When a joint-space move collides,
-RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: OMPL's, shortened by
-OMPL's path simplifier (`ompl_search`), or ours, shortened by random shortcuts (`rrt`;
+RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: ours, shortened by
+random shortcuts (`rrt`), or OMPL's, shortened by OMPL's path simplifier (`ompl_search`;
 `MotionSettings.planner`). Every
 path is checked against a `CollisionChecker`, then time-parametrized within the joint speed,
 joint acceleration and TCP speed limits of `MotionSettings`.
@@ -53,8 +53,8 @@ def joint_path(
     s: MotionSettings,
     **kw,
 ) -> np.ndarray | None:
-    """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: OMPL's or
-    ours), shortened. None at once when the start or the goal is not clear: no edge can
+    """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
+    OMPL's), shortened. None at once when the start or the goal is not clear: no edge can
     leave it, and the search would spend all its samples (seconds) finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
         return np.array([q_start, q_goal], float)

@@ -1,6 +1,6 @@
-"""Our joint-space search: RRT-Connect (Kuffner and LaValle 2000) with random shortcuts, kept
-beside OMPL's (`ompl_search`, the default) to rerun the comparison of the two
-(`bench/planners.py`), and the box of joint angles both draw their samples from.
+"""Our joint-space search, the default: RRT-Connect (Kuffner and LaValle 2000) with random
+shortcuts, beside OMPL's (`ompl_search`; `bench/planners.py` compares the two), and the box
+of joint angles both draw their samples from.
 
 Frames: joint angles in rad.
 """

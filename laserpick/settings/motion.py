@@ -109,10 +109,11 @@ class MotionSettings(BaseModel):
         0.3, gt=0, description="RRT-Connect extension step (rad, largest joint; ours)."
     )
     planner: Literal["ompl", "ours"] = Field(
-        "ompl",
-        description="The joint-space search: OMPL's RRT-Connect and path simplifier, or our"
-        " RRT-Connect with random shortcuts; both ask our collision check"
-        " (docs/pipeline.md compares them on recorded problems).",
+        "ours",
+        description="The joint-space search: our RRT-Connect with random shortcuts, or OMPL's"
+        " RRT-Connect and path simplifier; both ask our collision check. Ours: OMPL's"
+        " searches are quicker on recorded problems, but in the bench its tighter carries"
+        " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
     search_time: float = Field(
         60.0,
