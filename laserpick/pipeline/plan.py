@@ -4,9 +4,9 @@ Straight lines first: a straight joint-space move when it is clear, and straight
 lines (`lines`) for the approach and the lift. When a joint-space move collides,
 RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: ours, shortened by
 random shortcuts (`rrt`), or OMPL's, shortened by OMPL's path simplifier (`ompl_search`;
-`MotionSettings.planner`). Every
-path is checked against a `CollisionChecker`, then time-parametrized within the joint speed,
-joint acceleration and TCP speed limits of `MotionSettings`.
+`MotionSettings.planner`). Every path is checked against a `CollisionChecker`, then
+time-parametrized within the joint speed, joint acceleration and TCP speed limits of
+`MotionSettings`.
 
 Frames: TCP poses in `base` (m); joint angles in rad.
 """
