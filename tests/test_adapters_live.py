@@ -32,9 +32,17 @@ from laserpick.client import Client
 pytestmark = pytest.mark.timeout(400)
 
 
+#: The dead-man's window for these servers (s): its most (`ServerSettings.watchdog_s`). The
+#: adapters heartbeat every 0.15 s, but `make test` runs two workers beside the server and the
+#: adapter on two cores, where a heartbeat came more than the default 0.5 s apart and halted
+#: a stow. The dead-man at its default is `test_server.py`'s and `test_session.py`'s to test.
+WATCHDOG_S = "2.0"
+
+
 @pytest.fixture(scope="module")
 def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServeProcess]:
-    proc = ServeProcess(tmp_path_factory.mktemp("serve")).start()
+    env = {"LASERPICK_SERVER__WATCHDOG_S": WATCHDOG_S}
+    proc = ServeProcess(tmp_path_factory.mktemp("serve"), env=env).start()
     yield proc
     proc.close()
 
