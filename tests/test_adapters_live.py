@@ -32,7 +32,7 @@ from laserpick.client import Client
 pytestmark = pytest.mark.timeout(400)
 
 
-#: The dead-man's window for these servers (s): its most (`ServerSettings.watchdog_s`). The
+#: The dead-man's window for these servers (s): the widest `ServerSettings.watchdog_s` allows. The
 #: adapters heartbeat every 0.15 s, but `make test` runs two workers beside the server and the
 #: adapter on two cores, where a heartbeat came more than the default 0.5 s apart and halted
 #: a stow. The dead-man at its default is `test_server.py`'s and `test_session.py`'s to test.
