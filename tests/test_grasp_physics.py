@@ -14,12 +14,15 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.description import kinematics as K
-from laserpick.pipeline.timing import time_parametrize
+from laserpick.pipeline.timing import Limits, time_parametrize
 from laserpick.robot.sim.loop import Simulation
 from laserpick.robot.sim.objects import LIBRARY, min_width, support
 from laserpick.robot.sim.scenes import parse_scene
+from laserpick.settings import get_settings
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 from laserpick.types import Trajectory
+
+MOTION = get_settings().motion
 
 TABLE_HEIGHT = 0.46
 OBJECT_XY = (1.50, -0.25)
@@ -60,7 +63,8 @@ objects:
 
 def _joint_path(q0: np.ndarray, q1: np.ndarray, speed: float) -> Trajectory:
     """A rest-to-rest joint move at up to `speed` rad/s, timed by the pipeline's own planner."""
-    return time_parametrize(np.stack([q0, q1]), v_max=speed, a_max=dims.UR5_QDD_MAX)
+    limits = Limits(speed, dims.UR5_QDD_MAX, MOTION.joint_jerk)
+    return time_parametrize(np.stack([q0, q1]), limits=limits, tolerance=MOTION.blend_tolerance)
 
 
 def _top_down_grasp(obj_pos: np.ndarray, obj_quat: np.ndarray, model) -> np.ndarray:

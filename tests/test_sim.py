@@ -11,10 +11,13 @@ import pytest
 
 from laserpick.description import dims
 from laserpick.description import kinematics as K
-from laserpick.pipeline.timing import time_parametrize
+from laserpick.pipeline.timing import Limits, time_parametrize
 from laserpick.robot.sim.loop import Simulation
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.settings import get_settings
 from laserpick.types import GripperEvent, Trajectory
+
+MOTION = get_settings().motion
 
 
 @pytest.fixture
@@ -26,7 +29,8 @@ def sim():
 
 def _line(q0: np.ndarray, q1: np.ndarray, speed: float = 0.5) -> Trajectory:
     """A rest-to-rest joint move at up to `speed` rad/s, timed by the pipeline's own planner."""
-    return time_parametrize(np.stack([q0, q1]), v_max=speed, a_max=dims.UR5_QDD_MAX)
+    limits = Limits(speed, dims.UR5_QDD_MAX, MOTION.joint_jerk)
+    return time_parametrize(np.stack([q0, q1]), limits=limits, tolerance=MOTION.blend_tolerance)
 
 
 def test_contact_options_hold_a_parallel_jaw_grasp(sim):

@@ -1,69 +1,172 @@
-"""Time parametrization keeps joint speed, joint acceleration and TCP speed within limits."""
+"""Time parametrization: corners blended, the trajectory continuous in velocity and
+acceleration, and within the joint speed, acceleration and jerk limits and the TCP's cap."""
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 import pytest
 
+from laserpick.description import dims
 from laserpick.description import kinematics as K
-from laserpick.pipeline.timing import time_parametrize
+from laserpick.description.shapes import body_frames
+from laserpick.pipeline.collision.arm_spheres import sphere_centres
+from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.timing import Limits, excess, time_parametrize
+from laserpick.settings import get_settings
+
+LIMITS = Limits(speed=1.0, accel=2.0, jerk=20.0)
+TOL = 0.002
+#: A 90 degree corner in joints 1 and 2, a rad each way.
+CORNER = np.array([np.zeros(6), [1.0, 0, 0, 0, 0, 0], [1.0, 1.0, 0, 0, 0, 0]])
 
 
 def _rates(traj):
-    dt = np.diff(traj.times)
-    v = np.diff(traj.q, axis=0) / dt[:, None]
-    a = np.diff(v, axis=0) / dt[1:, None]
-    return v, a
+    """Joint velocities, accelerations and jerks (rad/s^n) of the samples by finite
+    differences, the arm at rest before and after, and the sample spacing (s)."""
+    h = float(np.diff(traj.times).max())
+    assert np.allclose(np.diff(traj.times), h)
+    rest = np.vstack([traj.q[:1]] * 3 + [traj.q] + [traj.q[-1:]] * 3)
+    v = np.diff(rest, axis=0) / h
+    a = np.diff(v, axis=0) / h
+    return v, a, np.diff(a, axis=0) / h, h
 
 
-def test_single_segment_respects_speed_and_acceleration_and_rests_at_the_ends():
+def _assert_smooth_within(traj, limits: Limits) -> None:
+    v, a, j, h = _rates(traj)
+    assert np.abs(v).max() <= limits.speed * (1 + 1e-9)
+    assert np.abs(a).max() <= limits.accel * (1 + 1e-9)
+    assert np.abs(j).max() <= limits.jerk * (1 + 1e-9)
+    # No velocity jump from one sample to the next, nor from rest at the ends.
+    assert np.abs(np.diff(v, axis=0)).max() <= limits.accel * h * (1 + 1e-9)
+
+
+def _off_polyline(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Each sample's distance (rad) from the polyline."""
+    gaps = []
+    for a, b in itertools.pairwise(poly):
+        u = (b - a) / np.linalg.norm(b - a)
+        along = np.clip((q - a) @ u, 0.0, np.linalg.norm(b - a))
+        gaps.append(np.linalg.norm(q - a - along[:, None] * u, axis=1))
+    return np.min(gaps, axis=0)
+
+
+def test_a_single_move_is_the_time_optimal_s_curve() -> None:
     q0 = np.zeros(6)
     q1 = np.array([1.2, -0.6, 0.9, 0.0, 0.3, -1.5])
-    traj = time_parametrize(np.stack([q0, q1]), v_max=1.0, a_max=2.0, dt=0.005)
-    v, a = _rates(traj)
-    assert np.abs(v).max() <= 1.0 + 1e-6
-    assert np.abs(a).max() <= 2.0 + 1e-3
+    traj = time_parametrize(np.stack([q0, q1]), limits=LIMITS, tolerance=TOL, dt=0.005)
+    _assert_smooth_within(traj, LIMITS)
     np.testing.assert_allclose(traj.q[0], q0)
     np.testing.assert_allclose(traj.q[-1], q1)
-    assert np.abs(v[0]).max() < 0.02 and np.abs(v[-1]).max() < 0.02
-    # The slowest joint (1.5 rad) sets the pace: cruise at 1 rad/s plus 0.5 s of ramps.
-    assert traj.duration == pytest.approx(1.5 + 1.0 / 2.0, abs=0.01)
+    # The slowest joint (1.5 rad) sets the pace: cruise at 1 rad/s, 0.5 s of ramps to reach
+    # it at 2 rad/s^2, and 0.1 s to reach that acceleration at 20 rad/s^3.
+    assert traj.duration == pytest.approx(1.5 + 1.0 / 2.0 + 2.0 / 20.0, abs=0.02)
 
 
-def test_short_moves_use_a_triangle_profile():
-    traj = time_parametrize(np.stack([np.zeros(6), np.full(6, 0.1)]), v_max=1.0, a_max=2.0)
-    v, _ = _rates(traj)
-    assert np.abs(v).max() < 1.0  # never reached cruise
-    assert traj.duration == pytest.approx(2 * np.sqrt(0.1 / 2.0), abs=0.02)
+def test_a_sharp_corner_is_blended_without_a_velocity_jump() -> None:
+    """A right-angled corner: the trajectory bends within the blend tolerance, its velocity
+    and acceleration continuous, every limit kept; the polyline's own timing would turn the
+    joint velocity through 90 degrees from one sample to the next."""
+    traj = time_parametrize(CORNER, limits=LIMITS, tolerance=TOL)
+    _assert_smooth_within(traj, LIMITS)
+    assert _off_polyline(traj.q, CORNER).max() <= TOL + 1e-9
+    np.testing.assert_allclose(traj.q[[0, -1]], CORNER[[0, -1]])
 
 
-def test_tcp_speed_cap_slows_a_long_reach():
+def test_a_checked_corner_is_cut_wider_and_sooner() -> None:
+    """Where the check passes every configuration, the blend may stray up to the checked
+    tolerance: the arm keeps its speed round the corner instead of nearly stopping."""
+    everywhere = lambda Q: np.ones(len(Q), bool)  # noqa: E731
+    tight = time_parametrize(CORNER, limits=LIMITS, tolerance=TOL)
+    wide = time_parametrize(
+        CORNER, limits=LIMITS, tolerance=TOL, checked_tolerance=0.3, clear=everywhere
+    )
+    _assert_smooth_within(wide, LIMITS)
+    off = _off_polyline(wide.q, CORNER).max()
+    assert 10 * TOL < off <= 0.3 + 1e-9
+    assert wide.duration < tight.duration - 0.3
+
+
+def test_a_blend_keeps_out_of_what_its_check_refuses() -> None:
+    """The inside of the corner is blocked from 0.1 rad off the legs: the blend shrinks until
+    every configuration along it passes the check, and the trajectory keeps out."""
+
+    def clear(Q: np.ndarray) -> np.ndarray:
+        return ~((Q[:, 0] < 0.9) & (Q[:, 1] > 0.1))
+
+    traj = time_parametrize(
+        CORNER, limits=LIMITS, tolerance=TOL, checked_tolerance=0.3, clear=clear
+    )
+    _assert_smooth_within(traj, LIMITS)
+    assert clear(traj.q).all()
+    assert _off_polyline(traj.q, CORNER).max() > 2 * TOL  # still cut wider than unchecked
+
+
+def test_the_tcp_never_outruns_its_cap() -> None:
     q0 = np.array([-0.4, -1.7, 1.5, 1.7, 1.57, 1.1])
     q1 = q0 + np.array([0.6, 0.3, -0.4, 0.0, 0.0, 0.0])
-    path = np.linspace(q0, q1, 30)
-    tcp = K.tcp_pose(path)[:, :3, 3]
-    fast = time_parametrize(path, v_max=3.14, a_max=3.0)
-    slow = time_parametrize(path, v_max=3.14, a_max=3.0, tcp=tcp, tcp_speed=0.25)
+    fast = time_parametrize(np.stack([q0, q1]), limits=Limits(3.14, 3.0, 30.0), tolerance=TOL)
+    capped = Limits(3.14, 3.0, 30.0, tcp_speed=0.25)
+    slow = time_parametrize(np.stack([q0, q1]), limits=capped, tolerance=TOL)
     assert slow.duration > fast.duration
     p = K.tcp_pose(slow.q)[:, :3, 3]
     speed = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(slow.times)
-    assert speed.max() <= 0.25 * 1.05  # 5 %: the path between waypoints is not a straight line
+    assert speed.max() <= 0.25 * (1 + 1e-9)
+    assert excess(slow.q, slow.times[1], capped)["tcp_speed"] <= 1.0
 
 
-def test_gripper_events_fire_at_their_waypoints():
+def test_a_straight_approach_keeps_its_speed_past_its_waypoints() -> None:
+    """A straight Cartesian line (waypoints 1 cm apart, each a small corner in joint space)
+    runs at the approach speed without slowing at its waypoints: 10 cm at 8 cm/s take 1.25 s
+    and a few tenths to speed up and slow down."""
+    s = get_settings().motion
+    q0 = dims.UR5_READY_Q
+    T = K.tcp_pose(q0)
+    T[2, 3] -= 0.10
+    path = cartesian_line(q0, T, s.cartesian_step)
+    limits = Limits(s.joint_speed, s.joint_accel, s.joint_jerk, tcp_speed=s.approach_speed)
+    traj = time_parametrize(path, limits=limits, tolerance=s.blend_tolerance)
+    _assert_smooth_within(traj, limits)
+    assert traj.duration < 1.25 + 0.4
+    p = K.tcp_pose(traj.q)[:, :3, 3]
+    assert np.linalg.norm(np.cross(p - p[0], T[:3, 3] - p[0]), axis=1).max() / 0.1 < 1e-3
+
+
+def test_gripper_events_fire_at_their_waypoints() -> None:
     path = np.array([np.zeros(6), np.full(6, 0.2), np.full(6, 0.4)])
-    traj = time_parametrize(path, v_max=1.0, a_max=2.0, gripper=((1, "close"),))
+    traj = time_parametrize(path, limits=LIMITS, tolerance=TOL, gripper=((1, "close"),))
     (event,) = traj.gripper
     assert event.action == "close"
     np.testing.assert_allclose(traj.sample(event.t), path[1], atol=1e-3)
 
 
-def test_bad_paths_are_refused_with_a_reason():
+def test_the_blend_tolerance_keeps_the_arm_within_the_clearance() -> None:
+    """A configuration `blend_tolerance` away (in any direction of joint space) from one the
+    planner checked moves no sphere of the arm's collision model more than a third of the
+    clearance the check kept: the spheres' Jacobians stretch no joint-space step more than
+    1.3 times (m per rad), over poses across the joint ranges."""
+    s = get_settings().motion
+    Q = np.random.default_rng(0).uniform(dims.UR5_Q_MIN, dims.UR5_Q_MAX, (5000, 6))
+    eps = 1e-6
+    here = sphere_centres(body_frames(Q))
+    jac = np.stack(
+        [(sphere_centres(body_frames(Q + eps * e)) - here) / eps for e in np.eye(6)], axis=-1
+    )
+    stretch = np.linalg.svd(jac, compute_uv=False)[..., 0].max()  # m per rad
+    assert 1.0 < stretch <= 1.35
+    assert stretch * s.blend_tolerance <= s.clearance / 3
+
+
+def test_bad_paths_are_refused_with_a_reason() -> None:
     with pytest.raises(ValueError, match="two"):
-        time_parametrize(np.zeros((1, 6)), v_max=1.0, a_max=1.0)
+        time_parametrize(np.zeros((1, 6)), limits=LIMITS, tolerance=TOL)
     with pytest.raises(ValueError, match="positive"):
-        time_parametrize(np.zeros((2, 6)), v_max=0.0, a_max=1.0)
+        Limits(speed=0.0, accel=1.0, jerk=1.0)
     with pytest.raises(ValueError, match="waypoint 5"):
         time_parametrize(
-            np.stack([np.zeros(6), np.ones(6)]), v_max=1, a_max=1, gripper=((5, "open"),)
+            np.stack([np.zeros(6), np.ones(6)]),
+            limits=LIMITS,
+            tolerance=TOL,
+            gripper=((5, "open"),),
         )

@@ -145,7 +145,11 @@ class GuardedMotion:
             return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
         carrying = kw.get("payload") is not None
         speed = s.carry_joint_speed if carrying else None
-        return Outcome(self.run(timed(path, s, joint_speed=speed), what))
+
+        def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
+            return checker.clearance_ok(Q, **kw)
+
+        return Outcome(self.run(timed(path, s, joint_speed=speed, clear=clear), what))
 
     def descend(
         self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0

@@ -47,6 +47,7 @@ class Picking(Withdrawing):
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
         held = self._take_hold(grasps, grasp, plan)
+        self.progress("Lifting the object.")
         failure, closed = self._regrip_and_lift(plan)
         if failure:
             if not self.should_stop():  # a cancel or an e-stop keeps what the hand holds
@@ -70,6 +71,7 @@ class Picking(Withdrawing):
         guarded = Trajectory(
             plan.approach.times, plan.approach.q, plan.approach.gripper, guard_force=s.guard_force
         )
+        self.progress("Approaching the object.")
         failure = self.run(guarded, "approaching the object")
         if failure and "unexpected contact" in failure.message:
             self._back_off_along_approach()

@@ -15,7 +15,7 @@ runs (`compare`).
 Importing this package loads no simulator: the command line parses with PROTOCOL_NAMES.
 """
 
-__all__ = ["FAILURE_KINDS", "PROTOCOL_NAMES", "STAGES"]
+__all__ = ["FAILURE_KINDS", "MOTION_STAGES", "PROTOCOL_NAMES", "STAGES"]
 
 #: The protocols, in the order the papers' experiments are listed (`protocols.PROTOCOLS` has
 #: the same keys; kept here so that the command line parses without loading the simulator).
@@ -52,3 +52,8 @@ STAGES = (
     "execute_sim",
     "attempt_total",
 )
+#: execute_sim split into the arm's stages (simulated s), at the session's progress messages:
+#: to the pre-grasp, the guarded approach, closing the hand, the re-grip and lift, and the
+#: carry until the hand has let go (pick-and-drop; a pick-and-place ends holding). Not part
+#: of attempt_total: they are execute_sim again.
+MOTION_STAGES = ("to_grasp", "approach", "close", "lift", "carry")

@@ -10,6 +10,16 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from laserpick.bench import MOTION_STAGES
+
+#: The progress messages at which one of MOTION_STAGES ends and the next begins.
+MOTION_MARKS = (
+    "Approaching the object.",
+    "Closing the gripper.",
+    "Lifting the object.",
+    "Holding the object.",
+)
+
 
 @dataclass
 class Attempt:
@@ -70,3 +80,24 @@ def stage_timings(jobs: list[dict[str, Any]], execute_sim: float | None = None) 
         timings.pop("acquire_cloud")
     timings["attempt_total"] = math.fsum(timings.values())
     return timings
+
+
+def motion_timings(
+    events: list[dict[str, Any]], start: float, released: float | None
+) -> dict[str, float]:
+    """execute_sim split into MOTION_STAGES (simulated s), from the session's progress
+    `events` (each stamped with its "sim_time"): each stage runs from the first message that
+    ends the stage before it (MOTION_MARKS; the first from `start`) to the first that ends
+    it, the carry to `released` (None: the hand did not let go). A stage whose ends were
+    not both seen is left out."""
+    at: dict[str, float] = {}
+    for e in events:
+        message = e.get("message")
+        if e.get("name") == "progress" and message in MOTION_MARKS and message not in at:
+            at[message] = float(e["sim_time"])
+    ends = [start, *(at.get(m) for m in MOTION_MARKS), released]
+    return {
+        stage: b - a
+        for stage, a, b in zip(MOTION_STAGES, ends[:-1], ends[1:], strict=True)
+        if a is not None and b is not None and b >= a
+    }

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from laserpick.bench.attempts import Attempt, stage_timings
+from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
 from laserpick.description import dims
 from laserpick.robot.sim.robot import SimRobot
@@ -303,9 +303,11 @@ class ScriptedOperator:
         t_sim = self._sim_time()
         s.execute(BENCH)
         self.wait()
-        execute_sim = self._released_at(k) - t_sim
+        released = self._released_at(k)
+        execute_sim = (self._sim_time() if released is None else released) - t_sim
         done = self._events_since(k, "job")
         rec.timings = stage_timings(done, execute_sim)  # the task's last job reports all its stages
+        rec.timings |= motion_timings(self._events[k:], t_sim, released)
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
@@ -324,13 +326,13 @@ class ScriptedOperator:
             rec.fail(s.failure.kind, s.failure.message)
         return rec.grasped and rec.detected
 
-    def _released_at(self, k: int) -> float:
+    def _released_at(self, k: int) -> float | None:
         """Simulated time (s) the job begun at event `k` let go of the object (dropped or set
-        down), or now if it has not: the attempt's execution ends there, not after the stow."""
+        down), None if it has not: the attempt's execution ends there, not after the stow."""
         for e in self._events[k:]:
             if e.get("name") == "progress" and e.get("message") in RELEASED:
                 return float(e["sim_time"])
-        return self._sim_time()
+        return None
 
     def pick_and_drop(self, rec: Attempt, aim: np.ndarray | None = None) -> Attempt:
         """One 004 section 8.1 attempt: success is the simulator's word that the marked

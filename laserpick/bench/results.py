@@ -20,7 +20,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from laserpick.bench import FAILURE_KINDS, STAGES
+from laserpick.bench import FAILURE_KINDS, MOTION_STAGES, STAGES
 
 #: The packages whose versions a run's outcomes depend on: the simulation's contacts, the
 #: cloud's geometry and the solvers'. Within pyproject.toml's ranges another version moves
@@ -35,6 +35,7 @@ RESULT_PACKAGES = (
     "daqp",
     "pin",
     "ur-analytic-ik",
+    "toppra",
     "ompl",
 )
 
@@ -120,7 +121,7 @@ def _timings(records: Sequence[dict[str, Any]]) -> dict[str, dict[str, float]]:
     the successful attempts, as 004 gives "the average time to complete a successful
     attempt" (section 8.2)."""
     out = {}
-    for stage in STAGES:
+    for stage in (*STAGES, *MOTION_STAGES):
         rows = [r for r in records if r["success"]] if stage == "attempt_total" else records
         xs = [r["timings"][stage] for r in rows if stage in r["timings"]]
         out[stage] = {

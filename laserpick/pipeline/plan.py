@@ -28,7 +28,8 @@ from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.rrt import rrt_connect, shortcut
-from laserpick.pipeline.timing import time_parametrize
+from laserpick.pipeline.smoothing import ClearFn
+from laserpick.pipeline.timing import Limits, time_parametrize
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Trajectory
 
@@ -129,15 +130,25 @@ def timed(
     tcp_speed: float | None = None,
     joint_speed: float | None = None,
     gripper: tuple[tuple[int, str], ...] = (),
+    clear: Sequence[ClearFn | None] | ClearFn | None = None,
 ) -> Trajectory:
-    """Time-parametrize a joint path within the motion limits (TCP speed capped near people;
-    `joint_speed` (rad/s) lowers the joint limit, e.g. while carrying)."""
+    """Time-parametrize a joint path within the motion limits of `s` (`timing`): its
+    corners blended, within `blend_tolerance` of the path, or `blend_checked` where the
+    legs' collision checks `clear` (one for all legs, or one per leg) pass the blend.
+    `tcp_speed` (m/s) and `joint_speed` (rad/s) lower the TCP and joint speed limits, e.g.
+    on the approach and while carrying; they never raise them."""
+    limits = Limits(
+        speed=min(joint_speed or s.joint_speed, s.joint_speed),
+        accel=s.joint_accel,
+        jerk=s.joint_jerk,
+        tcp_speed=min(tcp_speed or s.tcp_speed, s.tcp_speed),
+    )
     return time_parametrize(
         path,
-        v_max=min(joint_speed or s.joint_speed, s.joint_speed),
-        a_max=s.joint_accel,
-        tcp=tcp_pose(path)[:, :3, 3],
-        tcp_speed=tcp_speed or s.tcp_speed,
+        limits=limits,
+        tolerance=s.blend_tolerance,
+        checked_tolerance=s.blend_checked,
+        clear=clear,
         gripper=gripper,
     )
 
@@ -218,12 +229,15 @@ def transit_path(
     searches: Searches,
     via: Sequence[np.ndarray] = (),
     unstow: np.ndarray | None = None,
-) -> np.ndarray | None:
+) -> tuple[np.ndarray, list[ClearFn]] | None:
     """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`:
     through `unstow` first when the world shows it clear, then the first of `via` that it
     shows clear, each leg searched once per pick (`searches`). The leg to the pre-grasp
-    keeps the hand to space the cameras saw through. None when a leg finds no way."""
+    keeps the hand to space the cameras saw through. None when a leg finds no way; else the
+    waypoints and, for each segment between them, the check its leg was searched with (for
+    the blends of `timed`)."""
     transit = None
+    checks: list[ClearFn] = []
     first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
     clear = [q for q in via if world.clearance_ok(q)[0]]
     legs = [q_now, *first, *clear[:1], q_pre]
@@ -236,7 +250,14 @@ def transit_path(
         if leg is None:
             return None
         transit = leg if transit is None else np.vstack([transit, leg[1:]])
-    return transit
+        checks += [_leg_check(world, a, b, seen)] * (len(leg) - 1)
+    return None if transit is None else (transit, checks)
+
+
+def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool) -> ClearFn:
+    """The check `Searches.path` searched the leg from a to b with, for configurations."""
+    known = world.knowing(a, b) if seen else world
+    return lambda Q: known.clearance_ok(Q, hand=True, seen=seen)
 
 
 def plan_pick(
@@ -295,7 +316,7 @@ def plan_pick(
     if transit is None:
         return Failure("ik_plan", "No collision-free path to this grasp was found.")
     return PickPlan(
-        transit=timed(transit, s),
+        transit=timed(transit[0], s, clear=transit[1]),
         approach=timed(approach, s, tcp_speed=s.approach_speed),
         regrip=timed(up, s, tcp_speed=s.approach_speed),
         lift=timed(lift, s, tcp_speed=s.approach_speed),

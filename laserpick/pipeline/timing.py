@@ -1,100 +1,345 @@
-"""Time parametrization of a joint path within joint speed, joint acceleration and TCP speed
-limits (paper 004 section 7.4 leaves this to its planner; we do it explicitly).
+"""Time parametrization of a joint path: smooth, time-optimal and jerk-limited, within the
+joint speed, joint acceleration, joint jerk and TCP speed limits.
 
-A path is a polyline of joint waypoints. Each segment gets the shortest duration that keeps
-every joint under `v_max` and the TCP under `tcp_speed` at full speed. Those durations define
-a path parameter sigma ("nominal time"); sigma then follows a trapezoidal profile with peak
-rate 1 and acceleration `a_max / v_max`, so that along each segment no joint accelerates
-faster than `a_max`. The arm starts and stops at rest.
+1. The polyline's corners are blended (`smoothing.corners`): the path is C2. A corner whose
+   blend would be too tight to take at STOP_SPEED is not: the arm comes to rest there, and
+   each part between such corners is timed alone.
+2. TOPP-RA (Pham and Pham 2018, the `toppra` package) finds the fastest path velocity
+   profile under the joint speed and acceleration limits and the TCP speed cap, the arm at
+   rest at both ends. Its path acceleration is constant between grid points and jumps at them.
+3. The profile is smoothed in time: s_f(t) is the mean of s over [t - tau, t]. Its path
+   velocity is (s(t) - s(t - tau)) / tau, its acceleration the mean of TOPP-RA's, so
+   continuous, and its jerk the change of TOPP-RA's acceleration over tau, divided by tau:
+   tau = a_max / j_max keeps a jump from rest to full acceleration within the jerk limit.
+   Along the bends, the path velocity is capped from the start so that the bends' own share
+   of the jerk (their curvature and its change, at speed) stays within half the limit.
+4. The trajectory is sampled every dt and checked by finite differences, the arm at rest
+   before and after: joint speed, acceleration and jerk and the TCP's speed. Where the
+   smoothing overshot (it lets the arm round a corner a little faster than TOPP-RA did), the
+   path velocity is capped around the samples that were over, and TOPP-RA runs again; where
+   the jerk was over, tau is widened (up to TAU_MAX times). After PASSES tries, what is left
+   over is taken out by slowing the whole part uniformly in time (speed scales with 1/k,
+   acceleration with 1/k^2, jerk with 1/k^3).
+
+Units: rad, s, m; TCP positions in `base`.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
+import toppra
+import toppra.algorithm
+import toppra.constraint
 
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.smoothing import BlendedPath, ClearFn, corners
 from laserpick.types import GripperEvent, Trajectory
 
+__all__ = ["Limits", "excess", "time_parametrize"]
 
-def segment_durations(
-    q: np.ndarray,
-    v_max: float,
-    tcp: np.ndarray | None = None,
-    tcp_speed: float | None = None,
+#: TOPP-RA's grid: at most this far apart (rad of path), and at least this many intervals
+#: in every piece of the path (a blend's curvature changes within it).
+GRID_STEP = 0.02
+GRID_PER_PIECE = 4
+#: Checks and corrections of the sampled trajectory before the last, uniform slow-down.
+PASSES = 4
+#: Corrections aim this far under the limits, so that sampling does not put them back over.
+MARGIN = 1.002
+#: TOPP-RA and the smoothing aim this much inside the limits, so that a profile at a limit
+#: is not taken for one over it by rounding.
+INSIDE = 1.0 - 1e-6
+#: Step (rad) of the finite difference that gives the TCP's speed along the path.
+_EPS = 1e-6
+#: Path velocity caps (rad of path per s): none is lower (the arm would barely move), none
+#: higher (TOPP-RA's bounds are squared).
+MIN_CAP = 1e-3
+LARGE = 1e3
+#: A corner whose blend the arm could take no faster than this (rad of path per s) is not
+#: blended: the arm stops there (a tight blend would take as long).
+STOP_SPEED = 0.05
+#: The widest the smoothing gets, in a_max / j_max: a switch from full acceleration to full
+#: deceleration needs twice the time of a start from rest.
+TAU_MAX = 2.0
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The motion's limits: joint speed (rad/s), acceleration (rad/s^2) and jerk (rad/s^3),
+    each for every joint; the TCP's speed (m/s, None: no cap)."""
+
+    speed: float
+    accel: float
+    jerk: float
+    tcp_speed: float | None = None
+
+    def __post_init__(self) -> None:
+        if not (self.speed > 0 and self.accel > 0 and self.jerk > 0):
+            raise ValueError("joint speed, acceleration and jerk limits must be positive")
+        if self.tcp_speed is not None and not self.tcp_speed > 0:
+            raise ValueError("the TCP speed cap must be positive")
+
+
+class _Path(toppra.interpolator.AbstractGeometricPath):
+    """A `BlendedPath` as TOPP-RA reads a path."""
+
+    def __init__(self, path: BlendedPath) -> None:
+        self._path = path
+        self._interval = np.array([0.0, path.length])
+
+    def __call__(self, path_positions, order: int = 0) -> np.ndarray:
+        return self._path(path_positions, order)
+
+    @property
+    def dof(self) -> int:
+        return 6
+
+    @property
+    def path_interval(self) -> np.ndarray:
+        return self._interval
+
+
+class _SpeedBound(toppra.constraint.LinearConstraint):
+    """Bounds on sd^2 at each grid point: the TCP's speed |dp/ds| sd <= tcp_speed (None: no
+    cap), and sd <= caps (N,), the grid's own caps."""
+
+    def __init__(self, tcp_speed: float | None, caps: np.ndarray) -> None:
+        super().__init__()
+        self.tcp_speed = tcp_speed
+        self.caps = caps
+        self.dof = 6
+
+    def compute_constraint_params(self, path, gridpoints):
+        xbound = np.zeros((len(gridpoints), 2))
+        xbound[:, 1] = np.minimum(self.caps, LARGE) ** 2
+        if self.tcp_speed is not None:
+            q, dq = path(gridpoints, 0), path(gridpoints, 1)
+            ahead = tcp_pose(q + _EPS * dq)[:, :3, 3]
+            behind = tcp_pose(q - _EPS * dq)[:, :3, 3]
+            rate = np.linalg.norm(ahead - behind, axis=1) / (2 * _EPS)  # m per rad of path
+            # The largest of its neighbours too: the bound holds between grid points.
+            edge = np.pad(rate, 1, mode="edge")
+            rate = np.maximum.reduce([edge[:-2], rate, edge[2:]])
+            cap = self.tcp_speed * INSIDE / np.maximum(rate, 1e-9)
+            xbound[:, 1] = np.minimum(xbound[:, 1], cap**2)
+        return None, None, None, None, None, None, xbound
+
+
+def _grid(path: BlendedPath) -> np.ndarray:
+    """TOPP-RA's grid points: every piece of the path split into equal intervals."""
+    x = path.poly.x
+    parts = [
+        np.linspace(a, b, max(GRID_PER_PIECE, math.ceil((b - a) / GRID_STEP)) + 1)[:-1]
+        for a, b in itertools.pairwise(x)
+    ]
+    return np.concatenate([*parts, [x[-1]]])
+
+
+def _fastest(path: BlendedPath, grid: np.ndarray, limits: Limits, caps: np.ndarray) -> np.ndarray:
+    """TOPP-RA's time-optimal path velocities sd (N,) at the grid points, each at most its
+    cap (rad of path per s)."""
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.full(6, limits.speed * INSIDE)),
+        toppra.constraint.JointAccelerationConstraint(np.full(6, limits.accel * INSIDE)),
+        _SpeedBound(limits.tcp_speed, caps),
+    ]
+    algo = toppra.algorithm.TOPPRA(constraints, _Path(path), gridpoints=grid)
+    _, sd, _ = algo.compute_parameterization(0.0, 0.0)
+    if sd is None:
+        raise RuntimeError("TOPP-RA found no parametrization of the path")
+    return np.maximum(sd, 0.0)
+
+
+@dataclass(frozen=True)
+class _Profile:
+    """s(t) at constant path acceleration between grid points, and its running integral."""
+
+    t: np.ndarray  # (N,) time at each grid point
+    s: np.ndarray
+    sd: np.ndarray
+    sdd: np.ndarray  # (N - 1,) constant on each interval
+    integral: np.ndarray  # (N,) integral of s from 0 to t
+
+    @classmethod
+    def of(cls, s: np.ndarray, sd: np.ndarray) -> _Profile:
+        ds = np.diff(s)
+        dt = 2.0 * ds / np.maximum(sd[:-1] + sd[1:], 1e-12)
+        sdd = (sd[1:] - sd[:-1]) / dt
+        t = np.concatenate([[0.0], np.cumsum(dt)])
+        piece = s[:-1] * dt + sd[:-1] * dt**2 / 2 + sdd * dt**3 / 6
+        return cls(t, s, sd, sdd, np.concatenate([[0.0], np.cumsum(piece)]))
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+    def integral_at(self, t: np.ndarray) -> np.ndarray:
+        """The integral of s(t) from 0 to t, with s = 0 before the start and the path's
+        length after the end."""
+        i = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.sdd) - 1)
+        u = np.clip(t, 0.0, self.duration) - self.t[i]
+        inside = self.integral[i] + self.s[i] * u + self.sd[i] * u**2 / 2 + self.sdd[i] * u**3 / 6
+        after = self.s[-1] * np.maximum(t - self.duration, 0.0)
+        return np.where(t <= 0.0, 0.0, inside + after)
+
+    def smoothed(self, t: np.ndarray, tau: float) -> np.ndarray:
+        """s_f(t): the mean of s over [t - tau, t]."""
+        return (self.integral_at(t) - self.integral_at(t - tau)) / tau
+
+
+def _ratios(q: np.ndarray, h: float, limits: Limits) -> dict[str, np.ndarray]:
+    """Per sample of q (T, 6) rad, h s apart, the largest ratio to its limit of the joint
+    speeds, accelerations and jerks and the TCP's speed that it takes part in: by finite
+    differences, the arm at rest before and after."""
+    pad = 3
+    rest = np.vstack([np.repeat(q[:1], pad, axis=0), q, np.repeat(q[-1:], pad, axis=0)])
+    v = np.abs(np.diff(rest, axis=0)).max(axis=1) / h
+    a = np.abs(np.diff(rest, 2, axis=0)).max(axis=1) / h**2
+    j = np.abs(np.diff(rest, 3, axis=0)).max(axis=1) / h**3
+    n = len(q)
+
+    def per_sample(d: np.ndarray) -> np.ndarray:  # difference i takes samples i .. i + k
+        k = len(rest) - len(d)
+        full = np.max([np.pad(d, (s, k - s)) for s in range(k + 1)], axis=0)
+        return full[pad : pad + n]
+
+    out = {
+        "speed": per_sample(v) / limits.speed,
+        "accel": per_sample(a) / limits.accel,
+        "jerk": per_sample(j) / limits.jerk,
+        "tcp_speed": np.zeros(n),
+    }
+    if limits.tcp_speed is not None and n > 1:
+        p = tcp_pose(q)[:, :3, 3]
+        step = np.linalg.norm(np.diff(p, axis=0), axis=1) / h / limits.tcp_speed
+        out["tcp_speed"] = np.maximum(np.append(step, 0.0), np.insert(step, 0, 0.0))
+    return out
+
+
+def excess(q: np.ndarray, h: float, limits: Limits) -> dict[str, float]:
+    """How far samples q (T, 6) rad, h s apart, go over each limit: the largest ratio of
+    value to limit of joint speed, acceleration, jerk and TCP speed, by finite differences,
+    the arm at rest before and after (1 is at the limit)."""
+    return {name: float(r.max()) for name, r in _ratios(q, h, limits).items()}
+
+
+def _slowdown(ratios: dict[str, np.ndarray]) -> np.ndarray:
+    """Per sample, how many times slower the arm must go there to keep the joint speed,
+    acceleration and TCP speed limits."""
+    return np.maximum.reduce([ratios["speed"], ratios["tcp_speed"], np.sqrt(ratios["accel"])])
+
+
+def _sampled(
+    path: BlendedPath, profile: _Profile, tau: float, slow: float, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times (T,), path positions (T,) and joint angles (T, 6) every dt, of the smoothed
+    profile slowed `slow` times (and up to one sample more, to end on a sample)."""
+    total = (profile.duration + tau) * slow
+    n = max(1, math.ceil(total / dt - 1e-9))
+    slow *= n * dt / total  # a whole number of samples dt apart: a little slower, if at all
+    t = np.arange(n + 1) * dt
+    s = np.clip(profile.smoothed(t / slow, tau), 0.0, path.length)
+    s[-1] = path.length
+    return t, s, path(s)
+
+
+def _lower_caps(
+    caps: np.ndarray, grid: np.ndarray, t: np.ndarray, s: np.ndarray, slow: np.ndarray, tau: float
 ) -> np.ndarray:
-    """Shortest time (s) for each of the K-1 segments at full speed.
-
-    q: (K, 6) joint waypoints (rad). tcp: (K, 3) TCP positions (m) at those waypoints, with
-    `tcp_speed` (m/s), to cap the hand's speed near people.
-    """
-    dq = np.max(np.abs(np.diff(q, axis=0)), axis=1) / v_max
-    if tcp is not None and tcp_speed is not None:
-        dq = np.maximum(dq, np.linalg.norm(np.diff(tcp, axis=0), axis=1) / tcp_speed)
-    return dq
-
-
-def _trapezoid(length: float, accel: float) -> tuple[float, float]:
-    """Cruise rate and total time of a rest-to-rest trapezoid over `length` with peak rate 1."""
-    if length <= 0:
-        return 0.0, 0.0
-    if length >= 1.0 / accel:  # reaches rate 1: ramps take 1/accel each, covering 1/accel
-        return 1.0, length + 1.0 / accel
-    peak = math.sqrt(length * accel)  # triangle
-    return peak, 2.0 * peak / accel
+    """The path velocity caps on the grid, lowered around each sample that needs `slow` > 1
+    to the path velocity it had there over `slow`, over the path it covers in tau either
+    side: the smoothing averages the profile over that much."""
+    sd = np.gradient(s, t)
+    caps = caps.copy()
+    for k in np.flatnonzero(slow > 1.0):
+        reach = sd[k] * tau + GRID_STEP
+        near = np.abs(grid - s[k]) <= reach
+        caps[near] = np.minimum(caps[near], max(sd[k] / (slow[k] * MARGIN), MIN_CAP))
+    return caps
 
 
-def _sigma_at(t: np.ndarray, length: float, accel: float) -> np.ndarray:
-    peak, total = _trapezoid(length, accel)
-    t_ramp = peak / accel
-    ramp_len = 0.5 * accel * t_ramp**2
-    return np.where(
-        t < t_ramp,
-        0.5 * accel * t**2,
-        np.where(
-            t < total - t_ramp,
-            ramp_len + peak * (t - t_ramp),
-            length - 0.5 * accel * np.clip(total - t, 0, None) ** 2,
-        ),
-    )
+def _bend_caps(path: BlendedPath, grid: np.ndarray, limits: Limits) -> np.ndarray:
+    """Path velocity caps (rad/s) that keep the jerk of the path's bends within half the
+    limit each: q''' sd^3 (the bend's change) and 3 q'' sd sdd (its curvature while the
+    arm speeds up or slows down at up to the acceleration limit)."""
+    bend = np.abs(path(grid, 2)).max(axis=1)
+    twist = np.abs(path(grid, 3)).max(axis=1)
+    with np.errstate(divide="ignore"):
+        return np.minimum(
+            np.cbrt(limits.jerk / 2 / twist), limits.jerk / 2 / (3 * limits.accel * bend)
+        )
+
+
+def _within_limits(
+    path: BlendedPath, limits: Limits, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The smoothed, sampled trajectory (times, s, q) within every limit (module docstring,
+    steps 2-4). Over the speed or acceleration limits, the path velocity is capped around
+    the samples that were; over the jerk limit, the smoothing is widened, up to TAU_MAX
+    times a_max / j_max, then capped too."""
+    grid = _grid(path)
+    caps = _bend_caps(path, grid, limits)
+    tau = tau_0 = limits.accel / limits.jerk / INSIDE
+    for _ in range(PASSES):
+        profile = _Profile.of(grid, _fastest(path, grid, limits, caps))
+        t, s, q = _sampled(path, profile, tau, 1.0, dt)
+        ratios = _ratios(q, t[1] - t[0], limits)
+        slow, jerk = _slowdown(ratios), ratios["jerk"]
+        if slow.max() <= 1.0 and jerk.max() <= 1.0:
+            return t, s, q
+        wider = min(tau * max(float(jerk.max()) * MARGIN, 1.0), TAU_MAX * tau_0)
+        if wider == tau:
+            slow = np.maximum(slow, np.cbrt(jerk))
+        caps = _lower_caps(caps, grid, t, s, slow, tau)
+        tau = wider
+    ratios = _ratios(q, t[1] - t[0], limits)
+    k = max(float(_slowdown(ratios).max()), float(ratios["jerk"].max()) ** (1 / 3), 1.0)
+    return _sampled(path, profile, tau, k * MARGIN, dt)
 
 
 def time_parametrize(
     q: np.ndarray,
     *,
-    v_max: float,
-    a_max: float,
-    tcp: np.ndarray | None = None,
-    tcp_speed: float | None = None,
+    limits: Limits,
+    tolerance: float,
+    checked_tolerance: float | None = None,
+    clear: Sequence[ClearFn | None] | ClearFn | None = None,
     dt: float = 0.01,
     gripper: tuple[tuple[int, str], ...] = (),
 ) -> Trajectory:
-    """A rest-to-rest trajectory along the joint polyline `q` (K, 6), sampled every `dt` s.
+    """A trajectory along the joint polyline q (K, 6) rad from rest to rest, sampled every
+    dt s, with its corners blended (`smoothing.corners`: within `tolerance` rad of
+    the polyline, or `checked_tolerance` where the leg checks `clear` pass the blend), and
+    coming to rest at a corner whose blend would allow less than STOP_SPEED.
 
-    gripper: (waypoint index, "open"|"close") pairs; each event fires when the arm reaches
-    that waypoint.
+    gripper: (waypoint index, "open"|"close") pairs; each event fires when the arm passes
+    that waypoint (the middle of its blend).
     """
     q = np.asarray(q, dtype=float)
     if q.ndim != 2 or q.shape[1] != 6 or len(q) < 2:
         raise ValueError(f"need at least two (6,) joint waypoints, got shape {q.shape}")
-    if not (v_max > 0 and a_max > 0 and dt > 0):
-        raise ValueError("v_max, a_max and dt must be positive")
-    seg = segment_durations(q, v_max, tcp, tcp_speed)
-    knots = np.concatenate([[0.0], np.cumsum(seg)])
-    length = float(knots[-1])
-    accel = a_max / v_max
-    _, total = _trapezoid(length, accel)
-    if total == 0.0:
-        return Trajectory(times=np.array([0.0]), q=q[:1].copy())
-    n = max(2, math.ceil(total / dt) + 1)
-    t = np.linspace(0.0, total, n)
-    sigma = np.clip(_sigma_at(t, length, accel), 0.0, length)
-    path = np.column_stack([np.interp(sigma, knots, q[:, j]) for j in range(6)])
-    # The time at which sigma reaches each waypoint, for gripper events.
-    events = []
-    for index, action in gripper:
+    if not (dt > 0 and tolerance > 0):
+        raise ValueError("dt and the blend tolerance must be positive")
+    for index, _ in gripper:
         if not 0 <= index < len(q):
             raise ValueError(f"gripper event at waypoint {index}, path has {len(q)}")
-        t_event = float(np.interp(knots[index], sigma, t)) if index else 0.0
-        events.append(GripperEvent(t_event, action))  # type: ignore[arg-type]
-    return Trajectory(times=t, q=path, gripper=tuple(events))
+    if np.all(np.abs(q - q[0]) < 1e-9):
+        return Trajectory(times=np.array([0.0]), q=q[:1].copy())
+    found = corners(q, tolerance, checked_tolerance=checked_tolerance, clear=clear)
+    stops = np.flatnonzero(found.blend_speed(limits.accel, limits.jerk) < STOP_SPEED)
+    times, samples, passed = [np.zeros(1)], [q[:1]], np.full(len(q), np.nan)
+    for path, waypoints in found.paths(stops):
+        t, s, part = _within_limits(path, limits, dt)
+        start = times[-1][-1]
+        at = start + np.interp(path.vertex_s, s, t)
+        passed[waypoints] = np.where(np.isnan(passed[waypoints]), at, passed[waypoints])
+        times.append(start + t[1:])
+        samples.append(part[1:])
+    q_out = np.concatenate(samples)
+    q_out[-1] = q[-1]
+    events = tuple(GripperEvent(float(passed[i]), action) for i, action in gripper)  # type: ignore[arg-type]
+    return Trajectory(times=np.concatenate(times), q=q_out, gripper=events)

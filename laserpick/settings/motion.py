@@ -39,6 +39,12 @@ class MotionSettings(BaseModel):
         description="Joint speed limit (rad/s) near people; the UR5 can do 3.14. 004 issue text.",
     )
     joint_accel: float = Field(1.5, gt=0, le=3.0, description="Joint acceleration (rad/s^2).")
+    joint_jerk: float = Field(
+        15.0,
+        gt=0,
+        description="Joint jerk limit (rad/s^3): full acceleration is reached in 0.1 s. Ours:"
+        " the UR5's datasheet gives none, and a trajectory without one jumps in acceleration.",
+    )
     tcp_speed: float = Field(0.25, gt=0, description="TCP speed limit near people (m/s).")
     carry_joint_speed: float = Field(
         0.5,
@@ -79,6 +85,19 @@ class MotionSettings(BaseModel):
     backoff: float = Field(0.05, gt=0, description="Retreat (m) after an unexpected contact.")
     clearance: float = Field(
         0.01, ge=0, description="Clearance (m) kept between the arm's spheres and the cloud."
+    )
+    blend_tolerance: float = Field(
+        0.002,
+        gt=0,
+        description="How far (rad, joint space) a blended corner may stray from the checked"
+        " path without a check of its own: no sphere of the arm's collision model moves more"
+        " than 1.3 m per rad of joint space, 2.6 mm here, a quarter of `clearance`.",
+    )
+    blend_checked: float = Field(
+        0.5,
+        gt=0,
+        description="How far (rad, joint space) a blended corner may stray from a planned path"
+        " where the blend passes the collision check of the path's legs.",
     )
     cartesian_step: float = Field(
         0.01, gt=0, description="Waypoint spacing (m) of straight-line Cartesian paths."

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from laserpick.bench import FAILURE_KINDS, STAGES
+from laserpick.bench import FAILURE_KINDS, MOTION_STAGES, STAGES
 from laserpick.bench.papers import Breakdown, Reference, TimingColumn, reference
 from laserpick.bench.report.checks import Check, check_targets
 from laserpick.bench.report.measures import Summary, failures, modes, ours_text, totals
@@ -156,12 +156,18 @@ def _timing_section(result: dict[str, Any], ref: Reference) -> list[str]:
     header = ["stage", *(f"{n} (n)" for n, _ in named), *(f"{c.label} ({c.cite})" for c in columns)]
     rows = [[s, *(_stage_cell(m, s) for _, m in named), *(_paper_cell(c, s) for c in columns)]
             for s in STAGES]  # fmt: skip
+    motion = [[f"motion: {s}", *(_stage_cell(m, s) for _, m in named), *(DASH for _ in columns)]
+              for s in MOTION_STAGES]  # fmt: skip
+    at = STAGES.index("execute_sim") + 1
+    rows[at:at] = [row for row in motion if any(cell != DASH for cell in row[1 : 1 + len(named)])]
     extra = dict.fromkeys(k for c in columns for k in c.extra)
     rows += [[k, *(DASH for _ in named), *(_paper_cell(c, k) for c in columns)] for k in extra]
     notes = [
         "Ours: mean ± std over the attempts that reached the stage (n); wall-clock time of the "
         "pipeline, except execute_sim (simulated time); attempt_total is their sum, over the"
-        " successful attempts."
+        " successful attempts. The motion rows split execute_sim at the session's progress"
+        " messages: to the pre-grasp, the guarded approach, closing the hand, the re-grip and"
+        " lift, the carry until the hand has let go."
     ]
     notes += [f"{c.label}: {c.note}." for c in columns if c.note]
     if not columns:
