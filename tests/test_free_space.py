@@ -105,6 +105,19 @@ def test_a_point_is_free_only_where_a_camera_saw_past_it():
     assert seen_free(behind[None], [frame, _frame(box=False)], TOL).all()
 
 
+def test_several_frames_free_a_point_where_any_one_of_them_does():
+    """Asked of several frames at once, with a tolerance per point, a point is free exactly
+    where one of the frames, asked alone, sees past it."""
+    frames = [_frame(), _frame(box=False), _frame(look_at=BOX_CENTRE + [0.0, 0.3, 0.0])]
+    rng = np.random.default_rng(0)
+    points = BOX_CENTRE + rng.uniform(-0.4, 0.4, (2000, 3))
+    tol = rng.uniform(0.0, 0.03, len(points))
+    alone = np.array([seen_free(points, [f], tol) for f in frames])
+    assert alone.any(axis=0).sum() > alone[0].sum() > 0  # the later frames free some more
+    assert (seen_free(points, frames, tol) == alone.any(axis=0)).all()
+    assert not seen_free(points, [], tol).any()
+
+
 def test_a_finger_in_the_box_unseen_back_is_refused_one_beside_it_is_not():
     frame = _frame()
     down, along_x, along_y = np.array([0, 0, -1.0]), np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
