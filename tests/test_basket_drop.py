@@ -13,12 +13,15 @@ from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, box_points, isolation_robot, 
 from basket import assert_in_basket
 
 from laserpick.behaviours import (
+    NO_BASKET_HOLD,
     Behaviours,
     basket_opening,
     drop_candidates,
     drop_configurations,
+    holds_over_basket,
     rank_drop_postures,
 )
+from laserpick.behaviours.drop_postures import clear_carrying
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -62,7 +65,7 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
     assert isinstance(found, GraspSet), found
     b = Behaviours(robot)
-    out = b.pick(found)
+    out = b.pick(found, to_basket=True)  # the screen admits a grasp the drop can use
     assert out.ok, out.failure
     assert referee.object_at(out.grasp.position) == name
     assert robot.gripper_state().holding
@@ -213,6 +216,53 @@ def test_an_object_that_fits_the_basket_from_few_upright_postures_may_also_be_la
     tilted = drops[len(upright) :]
     assert tilted, "tilted postures follow"
     assert not any(np.allclose(t, q) for t in tilted for q in drop_candidates())
+
+
+def test_a_box_held_near_its_end_fits_no_drop_posture_and_the_screen_says_so_first():
+    """A cereal box (25 x 6 x 19 cm) held 17 cm off its middle hangs beside the hand where
+    no drop posture is clear of the scooter: the carry's search finds none, and the screen
+    asked before the pick says no. Held at its middle, and a mug, both agree on yes."""
+    margin = 0.01
+    scooter = CollisionChecker(np.zeros((0, 3)), margin=margin)
+    box = box_points((0.25, 0.06, 0.19), step=0.02)
+    mug = box_points((0.08, 0.08, 0.10), step=0.02)
+    for payload, fits in ((box + [0.17, 0.0, 0.0], False), (box, True), (mug, True)):
+        drops = drop_configurations(dims.UR5_READY_Q, scooter, payload, settings=BEHAVIOUR)
+        assert bool(drops) is fits
+        assert holds_over_basket(payload, margin=margin, settings=BEHAVIOUR) is fits
+
+
+def test_the_coarse_first_clearance_check_changes_no_verdict():
+    """Asking first with one point of the payload per 5 cm, then with all of it where that
+    passed, gives the verdict of asking with all of it: some postures pass, some fail."""
+    payload = box_points((0.19, 0.06, 0.25), step=0.02) + [0.05, 0.0, 0.0]
+    scooter = CollisionChecker(np.zeros((0, 3)))
+    Q = np.array(drop_candidates(tilted=True)[::3])
+    whole = np.concatenate(
+        [scooter.clearance_ok(part, payload=payload) for part in np.array_split(Q, 20)]
+    )
+    assert 0 < whole.sum() < len(Q)
+    assert (clear_carrying(scooter, Q, payload) == whole).all()
+
+
+def test_a_pick_for_the_basket_takes_no_grasp_it_could_not_drop_from(robot):
+    """Where the object, held by any of its grasps, would hang where no drop posture fits,
+    a pick for the basket takes none of them: the arm stays where it is, holding nothing,
+    and the failure says why. A pick that is not for the basket is not asked."""
+    referee = Referee(robot)
+    perception = perceive(robot.capture(), point=referee.aim_point("mug_1"))
+    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+    assert isinstance(found, GraspSet), found
+    # Taken for a 40 cm cube about its middle: no posture holds that over the basket.
+    cube = box_points((0.4, 0.4, 0.4), step=0.05) - [0.0, 0.0, 0.2]
+    found.__dict__["carried"] = np.vstack([found.carried, found.target.mean(axis=0) + cube])
+    q0 = robot.joint_state().q
+    out = Behaviours(robot).pick(found, to_basket=True)
+    assert out.failure is not None and out.failure.kind == "ik_plan"
+    assert NO_BASKET_HOLD in out.failure.message
+    assert out.attempts == len(found.ordered())
+    assert np.abs(robot.joint_state().q - q0).max() < 1e-3
+    assert not robot.gripper_state().holding
 
 
 def test_a_tall_object_is_picked_and_dropped_in_the_basket():

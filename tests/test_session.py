@@ -358,8 +358,8 @@ def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() 
         stood = truth.world_position("mug_1")
         pick = b.pick
 
-        def pick_with_nowhere_to_hold_it(grasps: GraspSet, order=None) -> Outcome:
-            out = pick(grasps, order)
+        def pick_with_nowhere_to_hold_it(grasps: GraspSet, order=None, **kw) -> Outcome:
+            out = pick(grasps, order, **kw)
             held = b.held
             assert held is not None, out.failure
             held_at = []

@@ -18,6 +18,7 @@ from laserpick.behaviours.drop_postures import (
     basket_opening,
     drop_candidates,
     drop_configurations,
+    holds_over_basket,
     past_the_opening,
     rank_drop_postures,
 )
@@ -27,6 +28,7 @@ from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import (
     MARK_MOVES,
+    NO_BASKET_HOLD,
     NOT_HOLDING,
     PAST_THE_OPENING,
     crowded_message,
@@ -43,6 +45,7 @@ __all__ = [
     "GRIPPER_TIME",
     "MARK_MOVES",
     "NOT_HOLDING",
+    "NO_BASKET_HOLD",
     "PAST_THE_OPENING",
     "Approaching",
     "BasketDrop",
@@ -65,6 +68,7 @@ __all__ = [
     "drop_configurations",
     "front_wall",
     "holding_pose",
+    "holds_over_basket",
     "past_the_opening",
     "place_poses",
     "rank_drop_postures",

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MARK_MOVES", "NOT_HOLDING", "PAST_THE_OPENING", "crowded_message"]
+__all__ = ["MARK_MOVES", "NOT_HOLDING", "NO_BASKET_HOLD", "PAST_THE_OPENING", "crowded_message"]
 
 #: Which way (unit vector, `base` xy) a refused place mark should move, by the words the
 #: refusal ends with (`crowded_message`).
@@ -23,6 +23,10 @@ PAST_THE_OPENING = (
     "Part of it reached past the basket's opening when the hand let go, so it may lie on"
     " the rim or beside the basket: please check before the next drop."
 )
+
+#: Why a grasp was not taken for the basket: held that way, no posture the arm can reach
+#: holds the object over the basket's opening, so it would be carried there and brought back.
+NO_BASKET_HOLD = "Held that way, the object could not be held over the basket."
 
 #: The failure of a behaviour that needs the hand to hold something, when it holds nothing.
 NOT_HOLDING = "The hand is not holding anything."

@@ -6,11 +6,13 @@ stops the arm, which then backs off); close; lift 2 cm and close again (the re-g
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from laserpick.behaviours.carry import without_leftovers
+from laserpick.behaviours.drop_postures import holds_over_basket
 from laserpick.behaviours.hand import GRIPPER_TIME, closed_on_something
 from laserpick.behaviours.held import Held, WayIn
+from laserpick.behaviours.messages import NO_BASKET_HOLD
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
@@ -26,16 +28,21 @@ __all__ = ["Picking"]
 class Picking(Withdrawing):
     """The pick (`pick`)."""
 
-    def pick(self, grasps: GraspSet, order: Sequence[Grasp] | None = None) -> Outcome:
+    def pick(
+        self, grasps: GraspSet, order: Sequence[Grasp] | None = None, *, to_basket: bool = False
+    ) -> Outcome:
         """Pick with the first grasp of `order` (default: all, in score order) that plans.
-        Done, the hand holds the object (`held`), lifted and, from the side, drawn back."""
+        Done, the hand holds the object (`held`), lifted and, from the side, drawn back.
+        to_basket: the object goes to the basket next, so a grasp that holds it where no
+        drop posture fits is not taken (`holds_over_basket`)."""
         s = self.settings.motion
         if self.robot.gripper_state().holding:
             return Outcome(Failure("precondition", "The hand is already holding something."))
         order = list(order) if order is not None else grasps.ordered()
         self.way_in = None
         t0 = time.perf_counter()
-        plan, grasp, attempts = plan_first(grasps, self.current_q(), self.rng, order, s)
+        admit = self._basket_admits(grasps) if to_basket else None
+        plan, grasp, attempts = plan_first(grasps, self.current_q(), self.rng, order, s, admit)
         timings = {"plan": time.perf_counter() - t0}
         if isinstance(plan, Failure):
             msg = f"None of the {attempts} grasps could be planned ({plan.message})"
@@ -58,6 +65,21 @@ class Picking(Withdrawing):
             return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         self.progress("Holding the object.")
         return Outcome(None, grasp, attempts, timings, closed_width=closed)
+
+    def _basket_admits(self, grasps: GraspSet) -> Callable[[Grasp], Failure | None]:
+        """For `plan_first`: refuses a grasp that holds the object, as carried and as it
+        falls, where no drop posture holds it over the basket."""
+        carried = grasps.carried
+        falls = grasps.carried_as_seen if len(grasps.cut_off) else carried
+        margin, b = self.settings.motion.clearance, self.settings.behaviour
+
+        def admits(grasp: Grasp) -> Failure | None:
+            payload, fall = grasp.in_hand(carried), grasp.in_hand(falls)
+            if holds_over_basket(payload, fall, margin=margin, settings=b):
+                return None
+            return Failure("ik_plan", NO_BASKET_HOLD)
+
+        return admits
 
     def _reach_and_close(self, plan: PickPlan) -> Failure | None:
         """Open the hand, move to the pre-grasp, approach guarded, and close: None when the

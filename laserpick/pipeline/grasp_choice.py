@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import functools
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -296,8 +296,11 @@ def plan_first(
     rng: np.random.Generator,
     order: Sequence[Grasp] | None = None,
     settings: MotionSettings | None = None,
+    admit: Callable[[Grasp], Failure | None] | None = None,
 ) -> tuple[PickPlan | Failure, Grasp | None, int]:
     """Plan the grasps of `order` (default: all, best first) until one plans, as 004 does.
+    `admit`, where given, may refuse a grasp before it is planned, with the failure that
+    says why (what comes after the pick needs of it).
 
     From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose;
     from the stowed pose, through the unstow pose first.
@@ -313,11 +316,15 @@ def plan_first(
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
     searches = Searches(s.rrt_max_failed)
     carried = found.carried
-    tried = 0
+    tried, refused = 0, None
     for grasp in found.ordered() if order is None else order:
         tried += 1
         if grasp.ik is None:
             raise ValueError("plan_first needs grasps from the reachability filter")
+        refused = admit(grasp) if admit is not None else None
+        if refused is not None:
+            plan = refused
+            continue
         plan = plan_pick(
             q_now,
             grasp.ik,
@@ -337,6 +344,6 @@ def plan_first(
             msg = f"No collision-free path in {searches.failed} searches; no more were tried"
             plan = Failure("ik_plan", msg)
             break
-    if isinstance(plan, Failure) and searches.unseen_only(s):
+    if isinstance(plan, Failure) and plan is not refused and searches.unseen_only(s):
         plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
     return plan, None, tried

@@ -104,7 +104,7 @@ class Jobs(Retreat, Foresight):
     def _pick_job(self, order: list[Grasp]) -> None:
         grasps = self.task.grasps
         assert grasps is not None
-        out = self.behaviours.pick(grasps, order)
+        out = self.behaviours.pick(grasps, order, to_basket=self.mode == "pick_and_drop")
         if self.behaviours.held is not None:
             # The object has left its place: the views of the way in must not keep it there.
             above = grasps.stands_on + self.settings.behaviour.support_scatter
