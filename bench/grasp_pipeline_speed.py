@@ -18,7 +18,8 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.grasp_choice import GraspSet, find_grasps, plan_first
+from laserpick.pipeline.first_plan import plan_first
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.truth import capture
 from laserpick.types import Failure

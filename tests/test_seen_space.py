@@ -16,7 +16,8 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
-from laserpick.pipeline.grasp_choice import UNSEEN_WAYS, GraspSet, plan_first
+from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
+from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.plan import Searches, joint_path
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot

@@ -16,7 +16,8 @@ from laserpick.behaviours.messages import NO_BASKET_HOLD
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.grasp_choice import GraspSet, plan_first
+from laserpick.pipeline.first_plan import plan_first
+from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import PickPlan, timed
 from laserpick.pipeline.reach import pregrasp_pose

@@ -9,7 +9,7 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.grasp_choice import at_pose
+from laserpick.pipeline.first_plan import at_pose
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import timed
 

@@ -12,8 +12,9 @@ for where to set the object down. Frames: `base` (x forward, y left, z up), metr
 from laserpick.pipeline.approach import centroid_approach
 from laserpick.pipeline.cloud import fuse, ray_hit, voxel_downsample
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.gpd import detect_grasps
-from laserpick.pipeline.grasp_choice import GraspSet, find_grasps, plan_first
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.laser_spots import detect_mark
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.perceive import Perception, perceive

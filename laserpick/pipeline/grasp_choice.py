@@ -1,5 +1,5 @@
-"""From a perceived target to ordered, reachable grasps, and the first of them that plans
-(004 sections 6.2 and 7).
+"""From a perceived target to ordered, reachable grasps (004 sections 6.2 and 7); the first
+of them that plans is `first_plan`'s.
 
 The strategy's candidates (`strategies`) go through the reachability filter, are scored with
 004's objective and clustered by position. When GPD's candidates offer no reachable grasp,
@@ -13,17 +13,11 @@ from __future__ import annotations
 
 import functools
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from laserpick.description.dims import (
-    UR5_HIGH_READY_Q,
-    UR5_HOME_Q,
-    UR5_READY_Q,
-    UR5_UNSTOW_Q,
-)
 from laserpick.pipeline.collision import (
     CARRIED_VOXEL,
     SEEN_TOLERANCE,
@@ -34,21 +28,13 @@ from laserpick.pipeline.collision import (
 from laserpick.pipeline.free_space import beyond_view
 from laserpick.pipeline.parking_advice import back_up_advice
 from laserpick.pipeline.perceive import Perception
-from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled
 from laserpick.pipeline.selection import GraspClusters, group, score
 from laserpick.pipeline.strategies import STRATEGIES, Strategy, candidates
-from laserpick.settings import MotionSettings, Settings, get_settings
+from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure, Grasp
 
-READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
-#: Said after a pick's planning failure when some way to its grasps passed only through space
-#: no camera saw: the arm keeps to seen space, so the user knows why it did not go.
-UNSEEN_WAYS = (
-    "; the only ways found pass where the cameras could not see, and the arm keeps to where"
-    " they saw"
-)
 COMPLETED_MAX = 120  #: candidates on a target completed by symmetry that are filtered, at most
 TARGET_VOXEL = 0.01  #: m: the target's whole shape, as recalled views are checked against it
 
@@ -109,11 +95,6 @@ class GraspSet:
         """The target's middle (m, `base`), which a place turns it about (`object_middle`), as
         the cameras saw it: not the part `cut_off` stands in for."""
         return object_middle(self.target, self.carried_as_seen)
-
-
-def at_pose(q: np.ndarray | None, pose: np.ndarray) -> bool:
-    """Whether joint angles q (6,) (rad) are at `pose` (6,), within READY_TOLERANCE."""
-    return q is not None and bool(np.max(np.abs(q - pose)) < READY_TOLERANCE)
 
 
 def find_grasps(
@@ -288,62 +269,3 @@ class FilteredCandidates:
             # front and above, with the hand tilted about its closing axis, it does.
             self.add("gpd", complete=True, tilted=True, most=COMPLETED_MAX)
         return strategy
-
-
-def plan_first(
-    found: GraspSet,
-    q_now: np.ndarray,
-    rng: np.random.Generator,
-    order: Sequence[Grasp] | None = None,
-    settings: MotionSettings | None = None,
-    admit: Callable[[Grasp], Failure | None] | None = None,
-) -> tuple[PickPlan | Failure, Grasp | None, int]:
-    """Plan the grasps of `order` (default: all, best first) until one plans, as 004 does.
-    `admit`, where given, may refuse a grasp before it is planned, with the failure that
-    says why (what comes after the pick needs of it).
-
-    From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose;
-    from the stowed pose, through the unstow pose first.
-    The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
-    it there already. Returns the plan (or the last failure, which says so when ways
-    through space the cameras did not see were left untaken), its grasp and how many grasps
-    were tried.
-    """
-    s = settings or get_settings().motion
-    at_ready = at_pose(q_now, UR5_READY_Q)
-    via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
-    stowed = at_pose(q_now, UR5_HOME_Q)
-    plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
-    searches = Searches(s.rrt_max_failed)
-    carried = found.carried
-    tried, refused = 0, None
-    for grasp in found.ordered() if order is None else order:
-        tried += 1
-        if grasp.ik is None:
-            raise ValueError("plan_first needs grasps from the reachability filter")
-        refused = admit(grasp) if admit is not None else None
-        if refused is not None:
-            plan = refused
-            continue
-        plan = plan_pick(
-            q_now,
-            grasp.ik,
-            found.world,
-            found.surroundings,
-            rng,
-            s,
-            via=via,
-            check_hand=found.strategy == "vertical",
-            searches=searches,
-            unstow=UR5_UNSTOW_Q if stowed else None,
-            payload=grasp.in_hand(carried),
-        )
-        if not isinstance(plan, Failure):
-            return plan, grasp, tried
-        if searches.spent:
-            msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            plan = Failure("ik_plan", msg)
-            break
-    if isinstance(plan, Failure) and plan is not refused and searches.unseen_only(s):
-        plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
-    return plan, None, tried

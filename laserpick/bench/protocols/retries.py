@@ -10,7 +10,7 @@ import numpy as np
 from laserpick.bench.attempts import Attempt
 from laserpick.bench.parking import go_to_object
 from laserpick.bench.picking import ScriptedOperator
-from laserpick.pipeline.grasp_choice import UNSEEN_WAYS
+from laserpick.pipeline.first_plan import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import Scene
 
 #: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until

@@ -14,7 +14,7 @@ import numpy as np
 
 from laserpick.description import dims
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.grasp_choice import at_pose
+from laserpick.pipeline.first_plan import at_pose
 from laserpick.pipeline.recall import Recalled
 from laserpick.robot.interface import Robot
 from laserpick.server.session.captures import Capture, CaptureReads
