@@ -22,7 +22,7 @@ from laserpick.robot.sim.scenes import Scene, load_scene
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 from laserpick.types import DepthFrame, FusedCloud
 
-__all__ = ["Captured", "SimTruth", "capture"]
+__all__ = ["Captured", "SimTruth", "capture", "inside_basket"]
 
 
 @dataclass
@@ -195,12 +195,20 @@ class SimTruth:
         self.robot.sleep(0.3)
 
     def in_basket(self, instance: str) -> bool:
-        """Whether the object's origin lies inside the basket: within its walls, above its
-        floor and below its rim (with a little slack for a tall object leaning there)."""
-        p = self.position(instance)
-        lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
-        hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
-        return bool(np.all(p >= lo - [0.0, 0.0, 0.02]) and np.all(p <= hi + [0.0, 0.0, 0.05]))
+        """Whether the object lies in the basket: its centre of mass within the walls, above
+        the floor and below the rim (`inside_basket`)."""
+        return inside_basket(self.centre_of_mass(instance))
+
+
+def inside_basket(centre: np.ndarray) -> bool:
+    """Whether a centre of mass (m, `base`) lies inside the basket: within its walls, at
+    most 2 cm below its floor's top (contact slack) and below its rim. The object's origin,
+    the middle of its bottom face, says less: a cereal box that came to rest on its top,
+    standing in the basket with 9 cm out over the rim, has its origin above the rim and its
+    centre of mass inside; one lying across both rims has its centre of mass above them."""
+    lo = dims.BASKET_CENTER - dims.BASKET_INNER / 2
+    hi = dims.BASKET_CENTER + dims.BASKET_INNER / 2
+    return bool(np.all(centre >= lo - [0.0, 0.0, 0.02]) and np.all(centre <= hi))
 
 
 @dataclass
