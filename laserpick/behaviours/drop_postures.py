@@ -17,6 +17,7 @@ from laserpick.transforms import roty, rotz
 
 __all__ = [
     "basket_opening",
+    "clear_carrying",
     "drop_candidates",
     "drop_configurations",
     "holds_over_basket",
@@ -31,8 +32,8 @@ DropRank = tuple[int, int, int, int, float]
 CHUNK = 64
 #: The cell (m) of the coarse payload a posture is checked with first, one point of the held
 #: object in each. A posture that does not clear those points cannot clear them all, so only
-#: the postures it clears are checked again with every point: the same verdict, about three
-#: times faster where most postures fail, as they do for a long box held near its end.
+#: the postures it clears are checked again with every point: the same verdict, sooner where
+#: most postures fail, as they do for a long box held near its end.
 COARSE_PAYLOAD = 0.05
 
 
