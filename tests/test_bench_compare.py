@@ -132,6 +132,15 @@ def test_other_options_are_noted(old: dict[str, Any]) -> None:
     assert comparison.same and comparison.notes == ("option tremor_deg differs: 0.3 -> 0.5",)
 
 
+def test_another_cpu_model_is_noted(old: dict[str, Any]) -> None:
+    """Attempts repeat on one CPU model: a comparison across two says so."""
+    a = copy.deepcopy(old) | {"environment": {"cpu": "AMD EPYC"}}
+    b = copy.deepcopy(old) | {"environment": {"cpu": "Intel(R) Xeon(R) Processor"}}
+    notes = compare_results(a, b).notes
+    assert any(n.startswith("CPU differs: AMD EPYC -> Intel") for n in notes), notes
+    assert compare_results(a, copy.deepcopy(a)).notes == ()
+
+
 def test_other_commits_are_noted_not_counted_as_differences(old: dict[str, Any]) -> None:
     """A comparison is for a change of code: another commit, an unclean tree or a result
     written before commits were recorded is a note, and the attempts still match."""

@@ -204,6 +204,11 @@ def _run_notes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
     for name in sorted(set(old_pkg) & set(new_pkg)):
         if old_pkg[name] != new_pkg[name]:
             notes.append(f"package {name} differs: {old_pkg[name]} -> {new_pkg[name]}")
+    # Floating point differs in its last digits between CPU models: a grip a millimetre off
+    # sends a trial elsewhere, so attempts repeat on one machine only.
+    cpus = [(r.get("environment") or {}).get("cpu") for r in (old, new)]
+    if None not in cpus and cpus[0] != cpus[1]:
+        notes.append(f"CPU differs: {cpus[0]} -> {cpus[1]}; attempts repeat on one CPU model only")
     for which, result in (("old", old), ("new", new)):
         for error in result.get("errors") or []:
             notes.append(f"a trial of the {which} run broke off: {error.splitlines()[0]}")
