@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import functools
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -126,14 +126,11 @@ def drop_configurations(
     the projector, so few postures reach over it: they are searched, not assumed.
     """
     falls = payload if falls is None else falls
-    upright = drop_candidates(heights=settings.drop_heights)
-    ranked = rank_drop_postures(upright, q_ref, checker, payload, falls, settings)
+    upright, *others = _posture_families(payload, falls, q_ref, checker.margin, settings)
+    ranked = rank_drop_postures(upright(), q_ref, checker, payload, falls, settings)
     if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
-        held = np.vstack([payload, falls])
-        laid = laid_in_candidates(held, q_ref, settings.drop_lows, checker.margin)
-        tilted = drop_candidates(tilted=True, heights=settings.drop_heights)
-        for more in (laid, tilted):
-            ranked += rank_drop_postures(more, q_ref, checker, payload, falls, settings)
+        for more in others:
+            ranked += rank_drop_postures(more(), q_ref, checker, payload, falls, settings)
         inside = [kq for kq in ranked if kq[0][0] == 0]
         past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
         ranked = inside + past
@@ -160,19 +157,30 @@ def holds_over_basket(
     falls = payload if falls is None else falls
     free = _scooter_only(margin)
     q_ref = dims.UR5_READY_Q
-    held = np.vstack([payload, falls])
-    families = (
-        lambda: drop_candidates(heights=settings.drop_heights),
-        lambda: laid_in_candidates(held, q_ref, settings.drop_lows, margin),
-        lambda: drop_candidates(tilted=True, heights=settings.drop_heights),
-    )
-    for family in families:
+    for family in _posture_families(payload, falls, q_ref, margin, settings):
         candidates = family()
         for i in range(0, len(candidates), CHUNK):
             chunk = candidates[i : i + CHUNK]
             if rank_drop_postures(chunk, q_ref, free, payload, falls, settings):
                 return True
     return False
+
+
+def _posture_families(
+    payload: np.ndarray,
+    falls: np.ndarray,
+    q_ref: np.ndarray,
+    margin: float,
+    settings: BehaviourSettings,
+) -> tuple[Callable[[], Sequence[np.ndarray]], ...]:
+    """The drop's postures (rad) in the order they are searched, each worked out when first
+    asked: upright (`drop_candidates`), laying this object in (`laid_in_candidates`, from
+    q_ref, `margin` m off the walls), tilted."""
+    return (
+        lambda: drop_candidates(heights=settings.drop_heights),
+        lambda: laid_in_candidates(np.vstack([payload, falls]), q_ref, settings.drop_lows, margin),
+        lambda: drop_candidates(tilted=True, heights=settings.drop_heights),
+    )
 
 
 def clear_carrying(checker: CollisionChecker, Q: np.ndarray, payload: np.ndarray) -> np.ndarray:

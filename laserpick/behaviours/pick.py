@@ -70,13 +70,12 @@ class Picking(Withdrawing):
     def _basket_admits(self, grasps: GraspSet) -> Callable[[Grasp], Failure | None]:
         """For `plan_first`: refuses a grasp that holds the object, as carried and as it
         falls, where no drop posture holds it over the basket."""
-        carried = grasps.carried
-        falls = grasps.carried_as_seen if len(grasps.cut_off) else carried
+        carried, falls = grasps.carried, grasps.carried_as_seen  # one array where none was cut off
         margin, b = self.settings.motion.clearance, self.settings.behaviour
 
         def admits(grasp: Grasp) -> Failure | None:
-            payload, fall = grasp.in_hand(carried), grasp.in_hand(falls)
-            if holds_over_basket(payload, fall, margin=margin, settings=b):
+            fall = None if falls is carried else grasp.in_hand(falls)
+            if holds_over_basket(grasp.in_hand(carried), fall, margin=margin, settings=b):
                 return None
             return Failure("ik_plan", NO_BASKET_HOLD)
 
