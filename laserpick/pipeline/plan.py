@@ -26,6 +26,7 @@ from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
+from laserpick.pipeline.quicken import quicken
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.pipeline.smoothing import ClearFn
@@ -54,8 +55,9 @@ def joint_path(
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
-    OMPL's), shortened. None at once when the start or the goal is not clear: no edge can
-    leave it, and the search would spend all its samples (seconds) finding that out."""
+    OMPL's), shortened, then made quicker to run by partial shortcuts (`quicken`) where the
+    timing says so. None at once when the start or the goal is not clear: no edge can leave
+    it, and the search would spend all its samples (seconds) finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
         return np.array([q_start, q_goal], float)
     if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
@@ -63,11 +65,20 @@ def joint_path(
     record_search(q_start, q_goal, checker, kw)
     if s.planner == "ompl":
         budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
-        return ompl_connect(q_start, q_goal, checker, rng, **budget, **kw)
-    path = rrt_connect(
-        q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
-    )
-    return None if path is None else shortcut(path, checker, rng, **kw)
+        path = ompl_connect(q_start, q_goal, checker, rng, **budget, **kw)
+    else:
+        path = rrt_connect(
+            q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
+        )
+        path = None if path is None else shortcut(path, checker, rng, **kw)
+    if path is None:
+        return None
+    # A carry runs at the carrying speed (`GuardedMotion.go_to`): so is its path quickened.
+    speed = s.carry_joint_speed if kw.get("payload") is not None else s.joint_speed
+    quick = quicken(path, checker, rng, joint_speed=speed, tcp_speed=s.tcp_speed, **kw)
+    quick = shortcut(quick, checker, rng, **kw)
+    # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
+    return min((path, quick), key=lambda p: timed(p, s, joint_speed=speed).duration)
 
 
 @dataclass

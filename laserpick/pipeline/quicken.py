@@ -1,0 +1,97 @@
+"""Partial shortcuts (Geraerts and Overmars 2007) that make a searched joint path quicker to
+run: between two random points on the path, one joint at a time moves straight from its
+angle at the first to its angle at the second while the others keep their course. A
+search's path wanders in the joints that no obstacle needed (a wrist turned one way and
+back), and joins between the path's own vertices (`rrt.shortcut`) cannot straighten one
+joint alone.
+
+A change is kept only where it is clear by the same check as the search's, and quicker by
+`run_time`, the time the path takes at the joint speed limit or the TCP speed cap,
+whichever binds on each segment: what the arm's timing spends (`timing`), less its
+accelerations. Frames: joint angles in rad; TCP in `base`, m.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline.collision import CollisionChecker
+
+__all__ = ["quicken", "run_time"]
+
+#: Points along each segment at which the TCP's path is measured: a joint-space segment
+#: moves the TCP along an arc, not a chord.
+ARC_SAMPLES = 6
+#: A change must save at least this (s): smaller ones only add vertices.
+LEAST_GAIN = 0.02
+
+
+def segment_times(path: np.ndarray, joint_speed: float, tcp_speed: float) -> np.ndarray:
+    """(K-1,) the least time (s) each segment of `path` (K, 6) rad takes: its largest joint
+    motion at `joint_speed` (rad/s), or its TCP arc at `tcp_speed` (m/s), the longer."""
+    a, b = path[:-1], path[1:]
+    f = np.linspace(0.0, 1.0, ARC_SAMPLES)[None, :, None]
+    Q = a[:, None, :] + f * (b - a)[:, None, :]
+    p = tcp_pose(Q.reshape(-1, 6))[:, :3, 3].reshape(len(a), ARC_SAMPLES, 3)
+    arc = np.linalg.norm(np.diff(p, axis=1), axis=2).sum(axis=1)
+    return np.maximum(np.abs(b - a).max(axis=1) / joint_speed, arc / tcp_speed)
+
+
+def run_time(path: np.ndarray, joint_speed: float, tcp_speed: float) -> float:
+    """The least time (s) `path` (K, 6) rad takes at the speed limits (`segment_times`)."""
+    return float(segment_times(np.asarray(path, float), joint_speed, tcp_speed).sum())
+
+
+def _point_at(path: np.ndarray, along: np.ndarray, t: float) -> tuple[int, np.ndarray]:
+    """The segment index k and the configuration `t` along `path` (`along`: each vertex's
+    position, the largest joint's motion summed from the start, rad)."""
+    k = int(np.clip(np.searchsorted(along, t, side="right") - 1, 0, len(path) - 2))
+    f = (t - along[k]) / max(along[k + 1] - along[k], 1e-12)
+    return k, path[k] + f * (path[k + 1] - path[k])
+
+
+def quicken(
+    path: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    *,
+    joint_speed: float,
+    tcp_speed: float,
+    tries: int = 40,
+    **kw,
+) -> np.ndarray:
+    """`path` (K, 6) rad with `tries` random partial shortcuts tried, each kept where its new
+    segments pass `checker.segment_ok(..., **kw)` and it saves LEAST_GAIN s of `run_time`
+    at `joint_speed` (rad/s) and `tcp_speed` (m/s). The ends stay where they are."""
+    path = np.array(path, float)
+    times = segment_times(path, joint_speed, tcp_speed)
+    for _ in range(tries):
+        along = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(path, axis=0)).max(axis=1))])
+        if len(path) < 2 or along[-1] <= 0.0:
+            break
+        t1, t2 = np.sort(rng.uniform(0.0, along[-1], 2))
+        joint = int(rng.integers(6))
+        k1, q1 = _point_at(path, along, t1)
+        k2, q2 = _point_at(path, along, t2)
+        if k2 <= k1:  # within one segment, which is straight already
+            continue
+        middle = path[k1 + 1 : k2 + 1].copy()
+        middle[:, joint] = np.interp(along[k1 + 1 : k2 + 1], [t1, t2], [q1[joint], q2[joint]])
+        piece = np.vstack([path[k1], q1, middle, q2, path[k2 + 1]])
+        new_times = segment_times(piece, joint_speed, tcp_speed)
+        if new_times.sum() > times[k1 : k2 + 1].sum() - LEAST_GAIN:
+            continue
+        if not all(checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(piece)):
+            continue
+        path = np.vstack([path[:k1], piece, path[k2 + 2 :]])
+        times = np.concatenate([times[:k1], new_times, times[k2 + 1 :]])
+        repeated = np.abs(np.diff(path, axis=0)).max(axis=1) < 1e-9  # q1 fell on a vertex
+        if repeated.any():
+            end = path[-1].copy()
+            path = path[np.concatenate([[True], ~repeated])]
+            path[-1] = end
+            times = segment_times(path, joint_speed, tcp_speed)
+    return path
