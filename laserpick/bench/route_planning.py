@@ -6,6 +6,7 @@ Poses are (x, y, yaw) in `world` (m, rad); outlines are rectangles in `base` (m)
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
@@ -23,6 +24,10 @@ VIA_SPACING = 0.2
 #: m the user backs out from a surface before turning, beyond what they were asked: the
 #: first that leaves room.
 REVERSE_STEPS = (0.0, 0.4, 0.8, 1.2, 1.6)
+#: m, the longest move between two grid points of a way with several stops, and the cost
+#: (m per rad) of turning on the spot at a stop: a way that turns less is the better.
+HOP = 0.45
+TURN_COST = 0.3
 #: m before the parking spot where the user turns to face it and creeps in: the first that
 #: leaves room.
 APPROACH_DISTANCES = (0.8, 1.2)
@@ -219,4 +224,86 @@ def plan_drive(
                 moves, h = go(via, h, approach)
                 if clear(moves) and arrive_clear(approach, h):
                     return back, [via, approach]
+    # No way with one stop: a way with several, once backed out as far as asked.
+    back = max(reverse_first, 0.0)
+    out = start[:2] - back * np.array([math.cos(start[2]), math.sin(start[2])])
+    if back > 0 and not clear(straight_poses(start[:2], out, start[2]), at_start):
+        return None
+    leaving = at_start if back == 0 else frozenset()
+    for approach in approaches:
+        stops = _stops(np.r_[out, start[2]], approach, vias, go, clear, leaving, arrive_clear)
+        if stops is not None:
+            return back, stops
     return None
+
+
+def _stops(
+    start: np.ndarray,
+    approach: np.ndarray,
+    vias: np.ndarray,
+    go,
+    clear,
+    at_start: frozenset[str],
+    arrive_clear,
+) -> list[np.ndarray] | None:
+    """The points (m, `world` xy) of a way from `start` (x, y, yaw) through several of the
+    `vias` to `approach`, each move a turn on the spot and a straight drive that `clear`
+    passes, or None: the shortest by Dijkstra over moves of at most HOP between grid points
+    (the heading at a point is the one the shortest way there arrives with), then the stops
+    that can be skipped are (the way drives straight on past them)."""
+    nodes = np.vstack([start[:2], vias])
+    near = [np.flatnonzero(np.linalg.norm(nodes - p, axis=1) <= HOP) for p in nodes]
+    best = {0: 0.0}
+    heading, parent = {0: float(start[2])}, {0: -1}
+    frontier, done = [(0.0, 0)], set()
+    while frontier:
+        cost, u = heapq.heappop(frontier)
+        if u in done:
+            continue
+        done.add(u)
+        exempt = at_start if u == 0 else frozenset()
+        last, h = go(nodes[u], heading[u], approach)
+        if u > 0 and clear(last) and arrive_clear(approach, h):
+            way = _chain(parent, u, nodes) + [approach]
+            return _skipped(way, start, go, clear, at_start, arrive_clear)
+        for v in near[u]:
+            if v in done or v == u:
+                continue
+            moves, h = go(nodes[u], heading[u], nodes[v])
+            step = (
+                cost
+                + float(np.linalg.norm(nodes[v] - nodes[u]))
+                + TURN_COST * abs(wrap_angle(h - heading[u]))
+            )
+            if step < best.get(v, np.inf) and clear(moves, exempt):
+                best[v], heading[v], parent[v] = step, h, u
+                heapq.heappush(frontier, (step, v))
+    return None
+
+
+def _chain(parent: dict[int, int], u: int, nodes: np.ndarray) -> list[np.ndarray]:
+    """The points from the first after the start to node u, by `parent`."""
+    out = []
+    while u > 0:
+        out.append(nodes[u])
+        u = parent[u]
+    return out[::-1]
+
+
+def _skipped(points, start, go, clear, at_start, arrive_clear) -> list[np.ndarray]:
+    """`points` less the stops the way can drive past: from each stop kept, straight on to
+    the farthest later point whose move is clear. Where a move the search found clear, or
+    the creep in after the last, is not from the heading a skipped stop leaves, the way is
+    kept as it was found."""
+    kept, here, h, exempt = [], start[:2], float(start[2]), at_start
+    k = 0
+    while k < len(points):
+        for j in range(len(points) - 1, k - 1, -1):
+            moves, h_next = go(here, h, points[j])
+            if clear(moves, exempt):
+                break
+        else:
+            return list(points)
+        kept.append(points[j])
+        here, h, exempt, k = points[j], h_next, frozenset(), j + 1
+    return kept if arrive_clear(points[-1], h) else list(points)
