@@ -141,3 +141,33 @@ def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer
         x, y, yaw = parking_pose(table, 0.0, table.levels[0], across=across)
         in_base = invert(planar_pose(x, y, yaw)) @ np.append(spot, 1.0)
         assert in_base[1] == pytest.approx(dims.ARM_MOUNT_POS[1] + across, abs=1e-9)
+
+
+@pytest.mark.slow
+def test_where_no_way_with_one_stop_leads_the_user_drives_one_with_several() -> None:
+    """In-situ seed 7010: parked at the floor area's far corner beside a stuffed toy on the
+    floor, the user is to park at the counter. No way with one stop leads there (the creep
+    in needs the scooter already facing the counter, and the 73 cm table beside its
+    approach leaves no room to turn there); a way with several stops does, and every pose
+    of it keeps clear of everything but the counter it parks at."""
+    scene = load_scene("kitchen", seed=7010)
+    outline = Outline((-0.15, 1.3022), (-0.6822, 0.3844))  # as the referee had it there
+    toy = Footprint("stuffed_toy", (-1.1009, -1.3999), 0.0, (0.1003, 0.1029))
+    around = [s for s in scene.surfaces if s.kind != "floor"] + [toy]
+    start = np.array([-2.0439, -2.5071, 7.0665])
+    goal = np.array([0.55, -0.70, -math.pi / 2])
+    plan = plan_drive(start, goal, around, outline, 0.6, parked_at=("counter",))
+    assert plan is not None
+    back, waypoints = plan
+    assert len(waypoints) >= 3
+    heading = start[2]
+    here = start[:2] - back * np.array([math.cos(heading), math.sin(heading)])
+    poses = [straight_poses(start[:2], here, heading)]
+    for point in waypoints:
+        h = math.atan2(point[1] - here[1], point[0] - here[0])
+        poses += [turn_poses(here, heading, h), straight_poses(here, point, h)]
+        here, heading = point, h
+    poses += [turn_poses(here, heading, goal[2]), straight_poses(here, goal[:2], goal[2])]
+    others = [s for s in around if s.name != "counter"]
+    filled = base_points_at(np.vstack(poses), outline.points(filled=True))
+    assert clearance(others, filled).min() >= DRIVE_MARGIN
