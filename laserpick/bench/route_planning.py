@@ -249,8 +249,8 @@ def _stops(
     """The points (m, `world` xy) of a way from `start` (x, y, yaw) through several of the
     `vias` to `approach`, each move a turn on the spot and a straight drive that `clear`
     passes, or None: the shortest by Dijkstra over moves of at most HOP between grid points
-    (the heading at a point is the one the shortest way there arrives with), then the stops
-    that can be skipped are (the way drives straight on past them)."""
+    (the heading at a point is the one the shortest way there arrives with), less the stops
+    the scooter can drive straight past (`_skipped`)."""
     nodes = np.vstack([start[:2], vias])
     near = [np.flatnonzero(np.linalg.norm(nodes - p, axis=1) <= HOP) for p in nodes]
     best = {0: 0.0}

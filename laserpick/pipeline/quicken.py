@@ -29,7 +29,7 @@ ARC_SAMPLES = 6
 LEAST_GAIN = 0.02
 
 
-def segment_times(path: np.ndarray, joint_speed: float, tcp_speed: float) -> np.ndarray:
+def _segment_times(path: np.ndarray, joint_speed: float, tcp_speed: float) -> np.ndarray:
     """(K-1,) the least time (s) each segment of `path` (K, 6) rad takes: its largest joint
     motion at `joint_speed` (rad/s), or its TCP arc at `tcp_speed` (m/s), the longer."""
     a, b = path[:-1], path[1:]
@@ -41,8 +41,8 @@ def segment_times(path: np.ndarray, joint_speed: float, tcp_speed: float) -> np.
 
 
 def run_time(path: np.ndarray, joint_speed: float, tcp_speed: float) -> float:
-    """The least time (s) `path` (K, 6) rad takes at the speed limits (`segment_times`)."""
-    return float(segment_times(np.asarray(path, float), joint_speed, tcp_speed).sum())
+    """The least time (s) `path` (K, 6) rad takes at the speed limits (`_segment_times`)."""
+    return float(_segment_times(np.asarray(path, float), joint_speed, tcp_speed).sum())
 
 
 def _point_at(path: np.ndarray, along: np.ndarray, t: float) -> tuple[int, np.ndarray]:
@@ -67,7 +67,7 @@ def quicken(
     segments pass `checker.segment_ok(..., **kw)` and it saves LEAST_GAIN s of `run_time`
     at `joint_speed` (rad/s) and `tcp_speed` (m/s). The ends stay where they are."""
     path = np.array(path, float)
-    times = segment_times(path, joint_speed, tcp_speed)
+    times = _segment_times(path, joint_speed, tcp_speed)
     for _ in range(tries):
         along = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(path, axis=0)).max(axis=1))])
         if len(path) < 2 or along[-1] <= 0.0:
@@ -81,7 +81,7 @@ def quicken(
         middle = path[k1 + 1 : k2 + 1].copy()
         middle[:, joint] = np.interp(along[k1 + 1 : k2 + 1], [t1, t2], [q1[joint], q2[joint]])
         piece = np.vstack([path[k1], q1, middle, q2, path[k2 + 1]])
-        new_times = segment_times(piece, joint_speed, tcp_speed)
+        new_times = _segment_times(piece, joint_speed, tcp_speed)
         if new_times.sum() > times[k1 : k2 + 1].sum() - LEAST_GAIN:
             continue
         if not all(checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(piece)):
@@ -93,5 +93,5 @@ def quicken(
             end = path[-1].copy()
             path = path[np.concatenate([[True], ~repeated])]
             path[-1] = end
-            times = segment_times(path, joint_speed, tcp_speed)
+            times = _segment_times(path, joint_speed, tcp_speed)
     return path
