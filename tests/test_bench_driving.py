@@ -28,6 +28,22 @@ from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import invert, planar_pose
 
 
+def _driven(
+    start: np.ndarray, back: float, waypoints: list[np.ndarray], goal: np.ndarray
+) -> list[np.ndarray]:
+    """The poses of a planned way as `follow` drives it: backing out, then a turn on the
+    spot and a straight drive to each waypoint, then the turn to the goal's heading and the
+    creep in; one array a move."""
+    heading = start[2]
+    here = start[:2] - back * np.array([math.cos(heading), math.sin(heading)])
+    poses = [straight_poses(start[:2], here, heading)]
+    for point in waypoints:
+        h = math.atan2(point[1] - here[1], point[0] - here[0])
+        poses += [turn_poses(here, heading, h), straight_poses(here, point, h)]
+        here, heading = point, h
+    return poses + [turn_poses(here, heading, goal[2]), straight_poses(here, goal[:2], goal[2])]
+
+
 def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
     """From the 73 cm table to the counter, the straight way swings the scooter's front (the
     arm, 1.30 m ahead of the rear axle) through the table: the simulated scooter drives
@@ -45,14 +61,7 @@ def test_the_scripted_user_drives_around_tables_not_through_them() -> None:
         waypoints[-1], goal[:2] - 1.2 * np.array([0.0, -1.0])
     )
     # Replay the moves as drive_to drives them and look at every pose's outline.
-    heading = start[2]
-    here = start[:2] - back * np.array([math.cos(heading), math.sin(heading)])
-    poses = [straight_poses(start[:2], here, heading)]
-    for point in waypoints:
-        h = math.atan2(point[1] - here[1], point[0] - here[0])
-        poses += [turn_poses(here, heading, h), straight_poses(here, point, h)]
-        here, heading = point, h
-    poses += [turn_poses(here, heading, goal[2]), straight_poses(here, goal[:2], goal[2])]
+    poses = _driven(start, back, waypoints, goal)
     points = base_points_at(np.vstack(poses), outline.points())
     others = [s for s in scene.surfaces if s.name not in ("table_73", "counter")]
     assert clearance(others, points).min() >= DRIVE_MARGIN
@@ -160,14 +169,7 @@ def test_where_no_way_with_one_stop_leads_the_user_drives_one_with_several() -> 
     assert plan is not None
     back, waypoints = plan
     assert len(waypoints) >= 3
-    heading = start[2]
-    here = start[:2] - back * np.array([math.cos(heading), math.sin(heading)])
-    poses = [straight_poses(start[:2], here, heading)]
-    for point in waypoints:
-        h = math.atan2(point[1] - here[1], point[0] - here[0])
-        poses += [turn_poses(here, heading, h), straight_poses(here, point, h)]
-        here, heading = point, h
-    poses += [turn_poses(here, heading, goal[2]), straight_poses(here, goal[:2], goal[2])]
+    poses = _driven(start, back, waypoints, goal)
     others = [s for s in around if s.name != "counter"]
     filled = base_points_at(np.vstack(poses), outline.points(filled=True))
     assert clearance(others, filled).min() >= DRIVE_MARGIN
