@@ -169,10 +169,8 @@ class PickPlan:
     """The motions of one pick, executed in order with gripper commands between them.
 
     transit: from the arm's current pose to the pre-grasp (open hand); approach: the straight,
-    guarded line to the grasp; regrip: the straight 2 cm lift before closing again, at the
-    approach speed; lift: the straight lift to `lift` above the grasp, at the carry's speed
-    (the object hangs in the hand, squeezed twice, as it will all the way to the basket).
-    Each ends at rest.
+    guarded line to the grasp; regrip: the straight 2 cm lift before closing again; lift: the
+    straight lift to `lift` above the grasp. Each ends at rest.
     """
 
     transit: Trajectory
@@ -332,7 +330,7 @@ def plan_pick(
         transit=timed(transit[0], s, clear=transit[1]),
         approach=timed(approach, s, tcp_speed=s.approach_speed),
         regrip=timed(up, s, tcp_speed=s.approach_speed),
-        lift=timed(lift, s, joint_speed=s.carry_joint_speed),
+        lift=timed(lift, s, tcp_speed=s.approach_speed),
         q_grasp=q_grasp,
         q_lifted=lift[-1],
     )
