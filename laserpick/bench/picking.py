@@ -370,11 +370,13 @@ class ScriptedOperator:
     def tidy(self) -> None:
         """Reset what an attempt left: every object in the basket is taken out of the scene
         (the fetched one, or another a wrong grasp dropped there: it would stand in the beam's
-        way), so is an object still in the hand, an arm the session left out of its stowed
-        pose is moved home by hand, and the session is told."""
+        way), so is one that missed the basket and came to rest on the scooter (across the
+        basket's rim, on the deck: a helper would not leave it there for the next drops to
+        land on), so is an object still in the hand, an arm the session left out of its
+        stowed pose is moved home by hand, and the session is told."""
         s, robot = self.session, self.robot
         for name in self.referee.instances():
-            if self.referee.in_basket(name):
+            if self.referee.in_basket(name) or self.referee.rests_on_scooter(name):
                 self.referee.take_out(name)
         if s.state in (TaskState.HOLDING, TaskState.AWAITING_PLACE) or robot.gripper_state().closed:
             # What the hand holds is found before it opens: in the second the gripper takes,

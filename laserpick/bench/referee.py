@@ -16,7 +16,7 @@ import numpy as np
 
 from laserpick.bench.route_planning import Outline
 from laserpick.pipeline.cloud import fuse
-from laserpick.robot.sim.truth import Captured, SimTruth
+from laserpick.robot.sim.truth import Captured, SimTruth, on_scooter
 from laserpick.types import FusedCloud
 
 
@@ -67,6 +67,11 @@ class Referee(SimTruth):
         base = (self._T_base_world() @ np.c_[world, np.ones(len(world))].T).T
         lo, hi = base[:, :2].min(axis=0), base[:, :2].max(axis=0)
         return Outline((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
+
+    def rests_on_scooter(self, instance: str) -> bool:
+        """Whether the object lies on the scooter outside the basket (`on_scooter`), not in
+        the hand."""
+        return on_scooter(self.centre_of_mass(instance)) and not self.near_hand(instance)
 
     def view(self) -> View:
         """A look at the scene now: one capture of the cameras, labelled by the simulator. It

@@ -22,7 +22,7 @@ from laserpick.robot.sim.scenes import Scene, load_scene
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 from laserpick.types import DepthFrame, FusedCloud
 
-__all__ = ["Captured", "SimTruth", "capture", "inside_basket"]
+__all__ = ["Captured", "SimTruth", "capture", "inside_basket", "on_scooter"]
 
 
 @dataclass
@@ -198,6 +198,20 @@ class SimTruth:
         """Whether the object lies in the basket: its centre of mass within the walls, above
         the floor and below the rim (`inside_basket`)."""
         return inside_basket(self.centre_of_mass(instance))
+
+
+def on_scooter(centre: np.ndarray) -> bool:
+    """Whether a centre of mass (m, `base`) lies over the scooter, above the floor: behind
+    the arm's mount, within the scooter's width and the basket's reach across (5 cm past
+    either), and no lower than 5 cm under the deck's top. An object resting there, across
+    the basket's rim or on the deck, was let go and missed; no object stands on the
+    scooter otherwise (one in the hand is above it only while the arm holds it)."""
+    half = max(dims.SCOOTER_WIDTH / 2, float(np.abs(dims.BASKET_CENTER[1]) + 0.2)) + 0.05
+    return bool(
+        -dims.SCOOTER_REAR_OVERHANG <= centre[0] <= dims.ARM_MOUNT_POS[0]
+        and abs(centre[1]) <= half
+        and centre[2] >= dims.SCOOTER_DECK_HEIGHT - 0.05
+    )
 
 
 def inside_basket(centre: np.ndarray) -> bool:
