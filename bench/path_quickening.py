@@ -29,7 +29,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path, help="folders of recorded .npz problems")
     args = ap.parse_args()
-    s = get_settings().motion
+    s = get_settings().motion.model_copy(update={"quicken_paths": True})
     files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
     rows = []
     print("problem           carry  searched s  quickened s  plan s (searched, quickened)")

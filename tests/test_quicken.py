@@ -53,7 +53,7 @@ def test_no_change_is_kept_that_the_check_refuses():
         [[x, -0.2, z] for x in np.arange(1.45, 1.75, 0.02) for z in np.arange(0.46, 0.8, 0.02)]
     )
     checker = CollisionChecker(np.vstack([table(), wall]), voxel=0.0)
-    s = get_settings().motion
+    s = get_settings().motion.model_copy(update={"quicken_paths": True})
     saved = 0.0
     for seed in range(3):
         path = joint_path(detour[0], detour[-1], checker, np.random.default_rng(seed), s)

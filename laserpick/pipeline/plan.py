@@ -55,9 +55,10 @@ def joint_path(
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
-    OMPL's), shortened, then made quicker to run by partial shortcuts (`quicken`) where the
-    timing says so. None at once when the start or the goal is not clear: no edge can leave
-    it, and the search would spend all its samples (seconds) finding that out."""
+    OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
+    shortcuts (`quicken`) where the timing says so. None at once when the start or the goal
+    is not clear: no edge can leave it, and the search would spend all its samples (seconds)
+    finding that out."""
     if checker.segment_ok(q_start, q_goal, **kw):
         return np.array([q_start, q_goal], float)
     if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
@@ -71,8 +72,8 @@ def joint_path(
             q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
         )
         path = None if path is None else shortcut(path, checker, rng, **kw)
-    if path is None:
-        return None
+    if path is None or not s.quicken_paths:
+        return path
     # A carry runs at the carrying speed (`GuardedMotion.go_to`): so is its path quickened.
     speed = s.carry_joint_speed if kw.get("payload") is not None else s.joint_speed
     quick = quicken(path, checker, rng, joint_speed=speed, tcp_speed=s.tcp_speed, **kw)

@@ -115,6 +115,12 @@ class MotionSettings(BaseModel):
         " searches are quicker on recorded problems, but in the bench its tighter carries"
         " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
+    quicken_paths: bool = Field(
+        False,
+        description="Make each searched joint path quicker to run by partial shortcuts"
+        " (pipeline/quicken.py). Off by default until traced: on, the server test's TV remote"
+        " was set down 7.2 cm from its mark against the 5 cm it promises (docs/pipeline.md).",
+    )
     search_time: float = Field(
         60.0,
         gt=0,
