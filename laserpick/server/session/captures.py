@@ -23,6 +23,8 @@ log = logging.getLogger(__name__)
 
 #: A capture older than this (s) is not reused for aiming or a clicked mark.
 CAPTURE_MAX_AGE = 5.0
+#: rad: an arm joint moved more than this since a capture makes it stale.
+ARM_MOVED = 0.01
 
 
 class CamerasUnavailable(RuntimeError):
@@ -32,14 +34,15 @@ class CamerasUnavailable(RuntimeError):
 
 @dataclass(frozen=True)
 class Capture:
-    """One capture: the frames, their fused cloud (in `base`), the scooter's (x, y, yaw) pose
-    and the monotonic time (s) when it was taken. Replaced whole, so readers on other threads
-    never see a cloud with another capture's pose."""
+    """One capture: the frames, their fused cloud (in `base`), the scooter's (x, y, yaw) pose,
+    the monotonic time (s) when it was taken and the arm's joint angles then (rad). Replaced
+    whole, so readers on other threads never see a cloud with another capture's pose."""
 
     frames: tuple[DepthFrame, ...]
     cloud: FusedCloud
     pose: np.ndarray
     at: float
+    q: np.ndarray
 
 
 class CaptureReads(SessionCore):
@@ -68,7 +71,10 @@ class CaptureReads(SessionCore):
         return self._projection
 
     def _remember(self, frames: Sequence[DepthFrame], cloud: FusedCloud) -> Capture:
-        capture = Capture(tuple(frames), cloud, self.robot.base_pose(), time.monotonic())
+        robot = self.robot
+        capture = Capture(
+            tuple(frames), cloud, robot.base_pose(), time.monotonic(), robot.joint_state().q
+        )
         self._capture = capture
         return capture
 
@@ -89,12 +95,16 @@ class CaptureReads(SessionCore):
             return None
 
     def _fresh_capture(self) -> Capture | None:
-        """The last capture, if the scooter has not moved since and it is under
-        CAPTURE_MAX_AGE old (people move things)."""
+        """The last capture, if neither the scooter nor the arm has moved since and it is
+        under CAPTURE_MAX_AGE old (people move things). The arm's own points are left out
+        by where it stands now: in a capture taken with it elsewhere, the arm would stand
+        in its own way."""
         capture = self._capture
         if capture is None or time.monotonic() - capture.at > CAPTURE_MAX_AGE:
             return None
         if np.max(np.abs(capture.pose - self.robot.base_pose())) > 1e-3:
+            return None
+        if np.max(np.abs(capture.q - self.robot.joint_state().q)) > ARM_MOVED:
             return None
         return capture
 
