@@ -18,7 +18,7 @@ from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
 from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
-from laserpick.pipeline.plan import Searches, joint_path
+from laserpick.pipeline.plan import Searches, joint_path, plan_pick
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
@@ -81,6 +81,23 @@ def test_where_the_arm_stood_and_the_way_out_count_as_seen(world):
     stood = CollisionChecker(world.points, filtered=True, frames=world.frames, q_self=right)
     assert stood.clearance_ok(right, seen=True)[0]
     assert not stood.clearance_ok(_hand_at(1.40, -0.65, 0.80), seen=True)[0]
+
+
+def test_from_standing_by_the_way_to_ready_is_a_fixed_way_beside_the_scooter(world):
+    """Standing by (`UR5_STANDBY_Q`) beside the scooter, the hand rises to the ready pose
+    through space no camera sees, as it does on the way out of the stowed pose: that leg
+    is not held to seen space, and the pick plans; the leg on to the grasp still is."""
+    s = get_settings().motion
+    standby = dims.UR5_STANDBY_Q
+    way = np.linspace(standby, READY, 30)
+    assert not world.knowing(standby, READY).clearance_ok(way, hand=True, seen=True).all()
+    q_grasp = _hand_at(1.55, -0.20, 0.55)
+    plan = plan_pick(
+        standby, q_grasp, world, world, np.random.default_rng(0), s, via=(READY,), standby=True
+    )
+    assert not isinstance(plan, Failure), plan
+    held = plan_pick(standby, q_grasp, world, world, np.random.default_rng(0), s, via=(READY,))
+    assert isinstance(held, Failure), "held to seen space, no way leads out from beside"
 
 
 def test_a_planned_transit_keeps_the_hand_in_seen_space(world):

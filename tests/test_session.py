@@ -259,11 +259,11 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         session.close()
 
 
-def _fetch_mug(session: Session, actor: Actor, mode: Mode) -> None:
-    """Mark the isolation scene's mug, confirm, and execute in `mode`, as a user does; wait
-    for each job to end."""
-    mug = SimTruth(session.robot).object_points("mug_1")
-    centre = (mug.min(axis=0) + mug.max(axis=0)) / 2
+def _fetch_mug(session: Session, actor: Actor, mode: Mode, name: str = "mug_1") -> None:
+    """Mark the isolation scene's mug (or the object `name`), confirm, and execute in `mode`,
+    as a user does; wait for each job to end."""
+    seen = SimTruth(session.robot).object_points(name)
+    centre = (seen.min(axis=0) + seen.max(axis=0)) / 2
     session.set_mode(actor, mode=mode)
     session.aim_at(actor, centre, "base")
     session.confirm(actor, point=centre)
@@ -282,6 +282,51 @@ def _mug_kept(session: Session, actor: Actor) -> Held:
     assert session.state == TaskState.HOLDING
     assert session.behaviours.held is not None
     return session.behaviours.held
+
+
+def test_a_capture_taken_with_the_arm_elsewhere_is_not_reused() -> None:
+    """A capture is reused while fresh, but not once the arm has moved: its cloud was taken
+    with the arm where it stood then, and the arm's own points are left out by where it
+    stands now. Reused after the move to ready, the hand at ready stood in its own way."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        capture = session.capture_now()
+        assert session.cloud() is capture.cloud
+        assert session.behaviours.go_ready().ok
+        assert session.cloud() is not capture.cloud
+    finally:
+        session.close()
+
+
+def test_after_a_drop_the_arm_stands_by_and_the_next_pick_leaves_from_there() -> None:
+    """After a drop in the basket the arm waits for the next pick standing by
+    (`UR5_STANDBY_Q`), not stowed: the next pick's way to its grasp keeps the elbow up, does
+    not pass the unstow pose, and the object reaches the basket too."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        actor, robot = Actor("bench"), session.robot
+        truth = SimTruth(robot)
+        robot.sleep(0.3)
+        _fetch_mug(session, actor, "pick_and_drop")
+        assert session.state == TaskState.IDLE and session.failure is None, session.message
+        assert np.abs(robot.joint_state().q - dims.UR5_STANDBY_Q).max() < 0.05, "standing by"
+        runs: list[np.ndarray] = []
+        execute = robot.execute
+
+        def recording(traj):
+            runs.append(traj.q)
+            return execute(traj)
+
+        robot.execute = recording  # type: ignore[method-assign]
+        _fetch_mug(session, actor, "pick_and_drop", name="ball_1")
+        assert session.state == TaskState.IDLE and session.failure is None, session.message
+        assert truth.in_basket("ball_1")
+        transit = runs[0]
+        np.testing.assert_allclose(transit[0], dims.UR5_STANDBY_Q, atol=0.05)
+        assert transit[:, 2].min() > 0.3, "the elbow stays up"
+        assert np.abs(transit - dims.UR5_UNSTOW_Q).max(axis=1).min() > 0.5
+    finally:
+        session.close()
 
 
 def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew() -> None:

@@ -79,5 +79,5 @@ __all__ = [
 
 class Behaviours(Picking, BasketDrop, Placing, PuttingBack, Approaching):
     """The robot's behaviours, run one at a time from the caller's thread: `pick`, `tuck`,
-    `drop_in_basket`, `place`, `put_back`, `approach`, `go_ready` and `stow`, on the
+    `drop_in_basket`, `place`, `put_back`, `approach`, `go_ready`, `stow` and `stand_by`, on the
     `Robot` given (see `GuardedMotion` for the arguments). `held` is what the hand holds."""

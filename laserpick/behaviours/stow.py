@@ -1,4 +1,4 @@
-"""To the ready pose, and folded away beside the scooter (stowed)."""
+"""To the ready pose, folded away beside the scooter (stowed), or standing by between picks."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ __all__ = ["Stowing"]
 
 
 class Stowing(GuardedMotion):
-    """Going to ready (`go_ready`) and stowing (`stow`)."""
+    """Going to ready (`go_ready`), stowing (`stow`) and standing by (`stand_by`)."""
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the ready pose, raised in front with the gripper down, or to the high ready
@@ -58,6 +58,18 @@ class Stowing(GuardedMotion):
         if not out.ok:
             return out
         return self.fold_away(checker)
+
+    def stand_by(self, checker: CollisionChecker | None = None) -> Outcome:
+        """Wait for the next pick folded back beside the scooter (`dims.UR5_STANDBY_Q`):
+        out of the cameras' view, and a way to the ready poses that keeps the elbow up.
+        Stowed instead where no way there is found. checker: as for `go_ready`."""
+        if at_pose(self.current_q(), dims.UR5_STANDBY_Q):
+            return Outcome()
+        around = checker or CollisionChecker(np.zeros((0, 3)))
+        out = self.go_to(dims.UR5_STANDBY_Q, around, "standing by", via=(dims.UR5_HIGH_READY_Q,))
+        if out.failure is not None and out.failure.kind == "ik_plan":
+            return self.stow(checker)
+        return out
 
     def fold_away(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the unstow pose, then straight home: the way out of the stowed pose, backwards,

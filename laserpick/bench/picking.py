@@ -24,7 +24,7 @@ import numpy as np
 
 from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
-from laserpick.description import dims
+from laserpick.pipeline.first_plan import at_rest
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
 from laserpick.server.session import (
@@ -372,8 +372,8 @@ class ScriptedOperator:
         (the fetched one, or another a wrong grasp dropped there: it would stand in the beam's
         way), so is one that missed the basket and came to rest on the scooter (across the
         basket's rim, on the deck: a helper would not leave it there for the next drops to
-        land on), so is an object still in the hand, an arm the session left out of its
-        stowed pose is moved home by hand, and the session is told."""
+        land on), so is an object still in the hand, an arm the session left neither stowed
+        nor standing by is moved home by hand, and the session is told."""
         s, robot = self.session, self.robot
         for name in self.referee.instances():
             if self.referee.in_basket(name) or self.referee.rests_on_scooter(name):
@@ -391,7 +391,7 @@ class ScriptedOperator:
             robot.sleep(1.0)
             for name in in_hand:
                 self.referee.take_out(name)
-        if np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) > 0.05:
+        if not at_rest(robot.joint_state().q):
             # By hand, as the experimenter would: a stow from here has no cloud to plan
             # around (the session, which had one, did not get the arm home), and can drive
             # the fingers into the furniture.

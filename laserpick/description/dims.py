@@ -69,6 +69,11 @@ UR5_UNSTOW_Q = np.array([-1.773, -0.338, -1.967, 0.734, -1.571, -0.203])
 #: x <= 1.23 and y >= -0.71, and an object up to 25 cm long and 5 cm in radius hangs clear of
 #: the arm and the scooter (found by a search over the side, nearest the high ready pose).
 UR5_CARRY_Q = np.array([-2.432, -1.182, 0.68, 2.074, 1.571, 1.211])
+#: Where the empty arm waits between picks: the carry pose, on the ready poses' elbow-up
+#: branch. From the stowed pose the elbow turns over (3.3 rad, 7.6 s to ready at the limits
+#: near people); from here it does not (4.0 s). Out of the cameras' view of the workspace and
+#: within the footprint the scooter drives with while it carries (rad).
+UR5_STANDBY_Q = UR5_CARRY_Q
 #: Raised in front, elbow up, gripper pointing down with the TCP at about (1.50, -0.30, 0.85)
 #: in `base`: the transit pose between home and any grasp above the workspace. Far enough
 #: forward that the elbow clears the right sensor housings by 3 cm (rad).

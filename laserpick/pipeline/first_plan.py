@@ -9,13 +9,19 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from laserpick.description.dims import UR5_HIGH_READY_Q, UR5_HOME_Q, UR5_READY_Q, UR5_UNSTOW_Q
+from laserpick.description.dims import (
+    UR5_HIGH_READY_Q,
+    UR5_HOME_Q,
+    UR5_READY_Q,
+    UR5_STANDBY_Q,
+    UR5_UNSTOW_Q,
+)
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
-__all__ = ["READY_TOLERANCE", "UNSEEN_WAYS", "at_pose", "plan_first"]
+__all__ = ["READY_TOLERANCE", "UNSEEN_WAYS", "at_pose", "at_rest", "plan_first"]
 
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
 #: Said after a pick's planning failure when some way to its grasps passed only through space
@@ -31,6 +37,12 @@ def at_pose(q: np.ndarray | None, pose: np.ndarray) -> bool:
     return q is not None and bool(np.max(np.abs(q - pose)) < READY_TOLERANCE)
 
 
+def at_rest(q: np.ndarray | None) -> bool:
+    """Whether joint angles q (6,) (rad) are at a pose the arm rests in between tasks: stowed
+    (`UR5_HOME_Q`) or standing by between picks (`UR5_STANDBY_Q`)."""
+    return at_pose(q, UR5_HOME_Q) or at_pose(q, UR5_STANDBY_Q)
+
+
 def plan_first(
     found: GraspSet,
     q_now: np.ndarray,
@@ -43,8 +55,9 @@ def plan_first(
     `admit`, where given, may refuse a grasp before it is planned, with the failure that
     says why (what comes after the pick needs of it).
 
-    From anywhere but the ready pose (stowed, mostly) the transit goes through a ready pose;
-    from the stowed pose, through the unstow pose first.
+    From anywhere but the ready pose (stowed or standing by, mostly) the transit goes
+    through a ready pose; from the stowed pose, through the unstow pose first. From either,
+    the way to the ready pose is a fixed way beside the scooter (`plan.transit_path`).
     The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
     it there already. Returns the plan (or the last failure, which says so when ways
     through space the cameras did not see were left untaken), its grasp and how many grasps
@@ -54,6 +67,7 @@ def plan_first(
     at_ready = at_pose(q_now, UR5_READY_Q)
     via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
     stowed = at_pose(q_now, UR5_HOME_Q)
+    standby = at_pose(q_now, UR5_STANDBY_Q)
     plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
     searches = Searches(s.rrt_max_failed)
     carried = found.carried
@@ -77,6 +91,7 @@ def plan_first(
             check_hand=found.strategy == "vertical",
             searches=searches,
             unstow=UR5_UNSTOW_Q if stowed else None,
+            standby=standby,
             payload=grasp.in_hand(carried),
         )
         if not isinstance(plan, Failure):

@@ -241,11 +241,14 @@ def transit_path(
     searches: Searches,
     via: Sequence[np.ndarray] = (),
     unstow: np.ndarray | None = None,
+    standby: bool = False,
 ) -> tuple[np.ndarray, list[ClearFn]] | None:
     """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`:
     through `unstow` first when the world shows it clear, then the first of `via` that it
     shows clear, each leg searched once per pick (`searches`). The leg to the pre-grasp
-    keeps the hand to space the cameras saw through. None when a leg finds no way; else the
+    keeps the hand to space the cameras saw through; so do the legs before it, but for the
+    fixed way out of a rest pose (through `unstow`, or from `standby`, `UR5_STANDBY_Q`,
+    to a ready pose). None when a leg finds no way; else the
     waypoints and, for each segment between them, the check its leg was searched with (for
     the blends of `timed`)."""
     transit = None
@@ -253,11 +256,13 @@ def transit_path(
     first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
     clear = [q for q in via if world.clearance_ok(q)[0]]
     legs = [q_now, *first, *clear[:1], q_pre]
+    fixed = bool(first) or standby
     for k, (a, b) in enumerate(itertools.pairwise(legs)):
         # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
-        # beside the scooter and turns the elbow over above the cameras' view: a fixed way
-        # of straight moves, not held to seen space. Only the leg to the grasp is.
-        seen = k == len(legs) - 2 or not first
+        # beside the scooter and turns the elbow over above the cameras' view; the way from
+        # standing by rises from beside the scooter to the front. Both are fixed ways of
+        # straight moves, not held to seen space. Only the leg to the grasp is.
+        seen = k == len(legs) - 2 or not fixed
         leg = searches.path(a, b, world, rng, s, seen=seen)
         if leg is None:
             return None
@@ -284,12 +289,15 @@ def plan_pick(
     searches: Searches | None = None,
     unstow: np.ndarray | None = None,
     payload: np.ndarray | None = None,
+    standby: bool = False,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
     unstow: a configuration the transit passes through first, when the cloud shows it clear
     (from a stowed arm, `UR5_UNSTOW_Q`: the way out of the stowed pose, which stays beside
     the scooter, where no camera sees).
+    standby: the arm stands by between picks (`UR5_STANDBY_Q`): its way to a ready pose is
+    fixed too, beside the scooter.
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
@@ -324,7 +332,7 @@ def plan_pick(
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
-    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow)
+    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby)
     if transit is None:
         return Failure("ik_plan", "No collision-free path to this grasp was found.")
     return PickPlan(

@@ -151,7 +151,8 @@ class Jobs(Retreat, Foresight):
             assert out.failure is not None
             self._retreat(out.failure)
             return
-        self.stow_and_rest("Dropped in the basket." + (f" {out.caution}" if out.caution else ""))
+        said = "Dropped in the basket." + (f" {out.caution}" if out.caution else "")
+        self.stow_and_rest(said, standby=True)
 
     def _place_job(self) -> None:
         with self._lock:

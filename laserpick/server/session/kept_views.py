@@ -12,9 +12,8 @@ from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
-from laserpick.description import dims
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.first_plan import at_pose
+from laserpick.pipeline.first_plan import at_rest
 from laserpick.pipeline.recall import Recalled
 from laserpick.robot.interface import Robot
 from laserpick.server.session.captures import Capture, CaptureReads
@@ -40,10 +39,11 @@ class KeptViews(CaptureReads):
         in view on the way in. In real time the capture runs on its own thread, so the drive
         command does not wait on it; headless, it runs at once, so a run replays exactly."""
         robot = self.robot
-        # Only with the arm stowed and the hand empty, as they are when a grasp is planned:
-        # a view never shows the arm elsewhere, nor an object riding along in the hand.
-        stowed = at_pose(robot.joint_state().q, dims.UR5_HOME_Q)
-        if not stowed or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
+        # Only with the arm at rest (stowed or standing by) and the hand empty, as they are
+        # when a grasp is planned: a view never shows the arm reaching out, nor an object
+        # riding along in the hand. Its own points are left out by the joint angles kept.
+        resting = at_rest(robot.joint_state().q)
+        if not resting or robot.gripper_state().holding or not self.views.due(robot.base_pose()):
             return
         if not robot.realtime:
             self._take_view(robot)

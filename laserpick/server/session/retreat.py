@@ -62,15 +62,19 @@ class Retreat(KeptViews):
             around = around.without(~not_carried(around.points, held.at(tcp_pose(q))))
         self.behaviours.held = replace(held, surroundings=around, seen_from=now)
 
-    def stow_and_rest(self, message: str, placed: Outcome | None = None) -> None:
+    def stow_and_rest(
+        self, message: str, placed: Outcome | None = None, standby: bool = False
+    ) -> None:
         """Stow and rest, saying `message`; after a place (`placed`), first check from the
-        same capture that the object still stands where it was let go. A job's last step:
-        it moves the arm, so call it only while no job runs."""
+        same capture that the object still stands where it was let go. standby: rest standing
+        by for the next pick instead (`Behaviours.stand_by`), as after a drop in the basket.
+        A job's last step: it moves the arm, so call it only while no job runs."""
         capture = self.capture_or_none()
         gone = (
             placed is not None and capture is not None and self._placed_object_gone(capture, placed)
         )
-        out = self.behaviours.stow(self.surroundings(capture))
+        around = self.surroundings(capture)
+        out = self.behaviours.stand_by(around) if standby else self.behaviours.stow(around)
         with self._lock:
             self._forget_task()
             if out.failure is not None:  # the arm not home is said first; a fall with it
