@@ -13,6 +13,7 @@ from dataclasses import replace
 from laserpick.behaviours import GRIPPER_TIME, Outcome
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
+from laserpick.pipeline.first_plan import at_rest
 from laserpick.pipeline.recall import moved, moved_points
 from laserpick.pipeline.surface import still_standing
 from laserpick.robot.interface import DEADMAN_STOP
@@ -99,7 +100,8 @@ class Retreat(KeptViews):
         """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
         hand is kept (never dropped from height): the arm tucks it in and the session holds;
         where no way to tuck it in is found, it is put back where it was picked up, if the
-        arm can go back down the way it came (`Behaviours.put_back`), and the arm stows.
+        arm can go back down the way it came (`Behaviours.put_back`), and the arm stows
+        (an arm still at rest, stowed or standing by, stays there).
         After the e-stop or the dead-man the arm stays where it stopped.
         tucked: how the tuck that failed just now went (not tried again)."""
         if DEADMAN_STOP in failure.message:
@@ -132,8 +134,9 @@ class Retreat(KeptViews):
                 self.robot.gripper(False)
                 self.robot.sleep(GRIPPER_TIME)
             b.held = None
-            self._progress("Returning the arm.")
-            b.stow(self.surroundings(self.capture_or_none()))
+            if not at_rest(self.robot.joint_state().q):  # a pick that found no way: stays
+                self._progress("Returning the arm.")
+                b.stow(self.surroundings(self.capture_or_none()))
         with self._lock:
             if cancelled:
                 self._cancel.set()  # so the journal records the job as cancelled
