@@ -18,7 +18,7 @@ from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
 from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
-from laserpick.pipeline.plan import Searches, joint_path, plan_pick
+from laserpick.pipeline.plan import Searches, joint_path, plan_pick, transit_path
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
@@ -98,6 +98,33 @@ def test_from_standing_by_the_way_to_ready_is_a_fixed_way_beside_the_scooter(wor
     assert not isinstance(plan, Failure), plan
     held = plan_pick(standby, q_grasp, world, world, np.random.default_rng(0), s, via=(READY,))
     assert isinstance(held, Failure), "held to seen space, no way leads out from beside"
+
+
+def test_from_standing_by_under_a_board_the_way_out_passes_its_exit(world):
+    """Where a board fills both ready poses (a shelf's, a high table's), the way out of
+    standing by passes its exit (`UR5_STANDBY_EXIT_Q`): elbow up, the hand ahead of the
+    scooter's front right corner, in space that counts as seen, where the way out of the
+    stowed pose passes, so that the leg on, held to seen space, starts where the one from
+    the unstow pose does. Where a ready pose is clear, the way is direct."""
+    s = get_settings().motion
+    standby, exit_ = dims.UR5_STANDBY_Q, dims.UR5_STANDBY_EXIT_Q
+    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
+    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    boarded = world.with_points(board)
+    via = (READY, dims.UR5_HIGH_READY_Q)
+    assert not boarded.clearance_ok(np.array(via)).any()
+    assert exit_[2] > 0.3 and boarded.clearance_ok(exit_, seen=True)[0]
+    q_pre = _hand_at(1.55, -0.20, 0.65)
+    blind = CollisionChecker(boarded.points, filtered=True)  # the routing, not the seen test
+    for checker, passes in (
+        (blind, [standby, exit_]),
+        (CollisionChecker(world.points, filtered=True), [standby, READY]),
+    ):
+        route = transit_path(
+            standby, q_pre, checker, np.random.default_rng(0), s, Searches(6), via, exit_, True
+        )
+        assert route is not None
+        np.testing.assert_allclose(route[0][:2], passes)
 
 
 def test_a_planned_transit_keeps_the_hand_in_seen_space(world):

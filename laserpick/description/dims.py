@@ -74,6 +74,11 @@ UR5_CARRY_Q = np.array([-2.432, -1.182, 0.68, 2.074, 1.571, 1.211])
 #: near people); from here it does not (4.0 s). Out of the cameras' view of the workspace and
 #: within the footprint the scooter drives with while it carries (rad).
 UR5_STANDBY_Q = UR5_CARRY_Q
+#: The way out of standing by where neither ready pose is clear (a shelf's boards, a high
+#: table): the hand where the unstow pose holds it, ahead of the scooter's front right
+#: corner, gripper down, but elbow up. From standing by the way to a ready pose is direct
+#: (4.0 s); through here it is 4.4 s (rad).
+UR5_STANDBY_EXIT_Q = np.array([-1.722, -1.524, 1.479, 1.616, 1.571, 1.211])
 #: Raised in front, elbow up, gripper pointing down with the TCP at about (1.50, -0.30, 0.85)
 #: in `base`: the transit pose between home and any grasp above the workspace. Far enough
 #: forward that the elbow clears the right sensor housings by 3 cm (rad).

@@ -13,6 +13,7 @@ from laserpick.description.dims import (
     UR5_HIGH_READY_Q,
     UR5_HOME_Q,
     UR5_READY_Q,
+    UR5_STANDBY_EXIT_Q,
     UR5_STANDBY_Q,
     UR5_UNSTOW_Q,
 )
@@ -56,8 +57,9 @@ def plan_first(
     says why (what comes after the pick needs of it).
 
     From anywhere but the ready pose (stowed or standing by, mostly) the transit goes
-    through a ready pose; from the stowed pose, through the unstow pose first. From either,
-    the way to the ready pose is a fixed way beside the scooter (`plan.transit_path`).
+    through a ready pose; from the stowed pose, through the unstow pose first; from standing
+    by, through its exit where no ready pose is clear. From either, the way to the ready
+    pose is a fixed way beside the scooter (`plan.transit_path`).
     The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
     it there already. Returns the plan (or the last failure, which says so when ways
     through space the cameras did not see were left untaken), its grasp and how many grasps
@@ -90,7 +92,7 @@ def plan_first(
             via=via,
             check_hand=found.strategy == "vertical",
             searches=searches,
-            unstow=UR5_UNSTOW_Q if stowed else None,
+            unstow=UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
             standby=standby,
             payload=grasp.in_hand(carried),
         )

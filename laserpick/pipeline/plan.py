@@ -248,13 +248,16 @@ def transit_path(
     shows clear, each leg searched once per pick (`searches`). The leg to the pre-grasp
     keeps the hand to space the cameras saw through; so do the legs before it, but for the
     fixed way out of a rest pose (through `unstow`, or from `standby`, `UR5_STANDBY_Q`,
-    to a ready pose). None when a leg finds no way; else the
+    to a ready pose). From standing by, `unstow` is its exit (`UR5_STANDBY_EXIT_Q`), passed
+    only where no ready pose is clear. None when a leg finds no way; else the
     waypoints and, for each segment between them, the check its leg was searched with (for
     the blends of `timed`)."""
     transit = None
     checks: list[ClearFn] = []
-    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
     clear = [q for q in via if world.clearance_ok(q)[0]]
+    if standby and clear:
+        unstow = None  # the way to a ready pose is direct from standing by
+    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
     legs = [q_now, *first, *clear[:1], q_pre]
     fixed = bool(first) or standby
     for k, (a, b) in enumerate(itertools.pairwise(legs)):
@@ -297,7 +300,8 @@ def plan_pick(
     (from a stowed arm, `UR5_UNSTOW_Q`: the way out of the stowed pose, which stays beside
     the scooter, where no camera sees).
     standby: the arm stands by between picks (`UR5_STANDBY_Q`): its way to a ready pose is
-    fixed too, beside the scooter.
+    fixed too, beside the scooter; `unstow` is then its exit, taken only where no ready
+    pose is clear (`transit_path`).
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
