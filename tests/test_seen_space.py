@@ -127,6 +127,41 @@ def test_from_standing_by_under_a_board_the_way_out_passes_its_exit(world):
         np.testing.assert_allclose(route[0][:2], passes)
 
 
+def test_from_standing_by_to_a_grasp_on_the_other_elbow_branch_the_elbow_turns_on_the_way_out(
+    world,
+):
+    """A pre-grasp on the stowed pose's elbow branch (elbow down): from standing by (elbow
+    up) the way out ends at the unstow pose, through a ready pose where one is clear, as the
+    stow goes, so that the elbow turns over there and not on the leg held to seen space."""
+    s = get_settings().motion
+    standby = dims.UR5_STANDBY_Q
+    T = tcp_pose(READY)
+    T[:3, 3] = 1.40, -0.45, 0.75
+    q_pre = ik_tcp(T, UNSTOW)[0]
+    assert q_pre[2] < 0, "elbow down"
+    via = (READY, dims.UR5_HIGH_READY_Q)
+    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
+    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    for points, passes in ((world.points, [standby, READY, UNSTOW]), (board, [standby, UNSTOW])):
+        checker = CollisionChecker(points, filtered=True)
+        route = transit_path(
+            standby,
+            q_pre,
+            checker,
+            np.random.default_rng(0),
+            s,
+            Searches(6),
+            via,
+            dims.UR5_STANDBY_EXIT_Q,
+            True,
+            UNSTOW,
+        )
+        assert route is not None
+        at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
+        assert all(np.allclose(route[0][k], q) for k, q in zip(at, passes)), "passes them"
+        assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
+
+
 def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
     """From the ready pose to a hand beside the table's right edge: the path found keeps
     the hand out of the blind space beside the scooter at every step between. The ends may

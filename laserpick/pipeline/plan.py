@@ -242,29 +242,28 @@ def transit_path(
     via: Sequence[np.ndarray] = (),
     unstow: np.ndarray | None = None,
     standby: bool = False,
+    turn: np.ndarray | None = None,
 ) -> tuple[np.ndarray, list[ClearFn]] | None:
-    """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`:
-    through `unstow` first when the world shows it clear, then the first of `via` that it
-    shows clear, each leg searched once per pick (`searches`). The leg to the pre-grasp
-    keeps the hand to space the cameras saw through; so do the legs before it, but for the
-    fixed way out of a rest pose (through `unstow`, or from `standby`, `UR5_STANDBY_Q`,
-    to a ready pose). From standing by, `unstow` is its exit (`UR5_STANDBY_EXIT_Q`), passed
-    only where no ready pose is clear. None when a leg finds no way; else the
-    waypoints and, for each segment between them, the check its leg was searched with (for
-    the blends of `timed`)."""
+    """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`,
+    each leg searched once per pick (`searches`): through the way out of where the arm
+    rests (`_way_out`), or else through the first of `via` that the world shows clear. The
+    leg to the pre-grasp keeps the hand to space the cameras saw through; so do the legs
+    before it, but for the fixed way out of a rest pose. None when a leg finds no way; else
+    the waypoints and, for each segment between them, the check its leg was searched with
+    (for the blends of `timed`)."""
     transit = None
     checks: list[ClearFn] = []
     clear = [q for q in via if world.clearance_ok(q)[0]]
-    if standby and clear:
-        unstow = None  # the way to a ready pose is direct from standing by
-    first = [] if unstow is None or not world.clearance_ok(unstow)[0] else [unstow]
-    legs = [q_now, *first, *clear[:1], q_pre]
-    fixed = bool(first) or standby
+    out = _way_out(q_now, q_pre, world, clear, unstow, standby, turn)
+    fixed = out is not None
+    legs = [q_now, *(clear[:1] if out is None else out), q_pre]
     for k, (a, b) in enumerate(itertools.pairwise(legs)):
         # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
         # beside the scooter and turns the elbow over above the cameras' view; the way from
-        # standing by rises from beside the scooter to the front. Both are fixed ways of
-        # straight moves, not held to seen space. Only the leg to the grasp is.
+        # standing by rises from beside the scooter to the front (and turns the elbow over
+        # on to the unstow pose, for a grasp on that branch). Fixed ways of straight moves,
+        # not held to seen space. Only the leg to the grasp is: turning the elbow over on
+        # it swings the hand through space no camera saw, and finds no way.
         seen = k == len(legs) - 2 or not fixed
         leg = searches.path(a, b, world, rng, s, seen=seen)
         if leg is None:
@@ -272,6 +271,35 @@ def transit_path(
         transit = leg if transit is None else np.vstack([transit, leg[1:]])
         checks += [_leg_check(world, a, b, seen)] * (len(leg) - 1)
     return None if transit is None else (transit, checks)
+
+
+def _way_out(
+    q_now: np.ndarray,
+    q_pre: np.ndarray,
+    world: CollisionChecker,
+    clear: Sequence[np.ndarray],
+    unstow: np.ndarray | None,
+    standby: bool,
+    turn: np.ndarray | None,
+) -> list[np.ndarray] | None:
+    """The waypoints (rad) of the fixed way out of a rest pose to a pre-grasp q_pre: legs
+    of straight moves beside the scooter, where no camera sees, not held to seen space.
+    None when q_now is not a rest pose, or its way out is not clear in the `world`.
+
+    From the stowed pose (`unstow` given, `UR5_UNSTOW_Q`): through the unstow pose, then the
+    first `clear` ready pose, where the elbow turns over. From standing by (`standby`), the
+    elbow up: to the first clear ready pose, else through `unstow`, its exit
+    (`UR5_STANDBY_EXIT_Q`); for a pre-grasp on the other elbow branch, on to `turn` (the
+    unstow pose) as the stow goes, so that the elbow turns over on the way out, not on the
+    leg held to seen space."""
+    if not standby:
+        ok = unstow is not None and world.clearance_ok(unstow)[0]
+        return [unstow, *clear[:1]] if ok else None
+    if turn is not None and q_pre[2] * q_now[2] < 0 and world.clearance_ok(turn)[0]:
+        return [*clear[:1], turn]
+    if clear:
+        return [clear[0]]
+    return [unstow] if unstow is not None and world.clearance_ok(unstow)[0] else []
 
 
 def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool) -> ClearFn:
@@ -293,6 +321,7 @@ def plan_pick(
     unstow: np.ndarray | None = None,
     payload: np.ndarray | None = None,
     standby: bool = False,
+    turn: np.ndarray | None = None,
 ) -> PickPlan | Failure:
     """Plan a pick at the grasp whose IK solution is q_grasp (from `reach.reachable`).
 
@@ -301,7 +330,8 @@ def plan_pick(
     the scooter, where no camera sees).
     standby: the arm stands by between picks (`UR5_STANDBY_Q`): its way to a ready pose is
     fixed too, beside the scooter; `unstow` is then its exit, taken only where no ready
-    pose is clear (`transit_path`).
+    pose is clear (`transit_path`); `turn`, where the way from standing by ends for a
+    grasp on the other elbow branch (`UR5_UNSTOW_Q`).
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
@@ -336,7 +366,7 @@ def plan_pick(
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
-    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby)
+    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby, turn)
     if transit is None:
         return Failure("ik_plan", "No collision-free path to this grasp was found.")
     return PickPlan(
