@@ -116,10 +116,9 @@ class MotionSettings(BaseModel):
         " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
     quicken_paths: bool = Field(
-        False,
+        True,
         description="Make each searched joint path quicker to run by partial shortcuts"
-        " (pipeline/quicken.py). Off by default until traced: on, the server test's TV remote"
-        " was set down 7.2 cm from its mark against the 5 cm it promises (docs/pipeline.md).",
+        " (pipeline/quicken.py); off, a searched path is run as the search left it.",
     )
     search_time: float = Field(
         60.0,
