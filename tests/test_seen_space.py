@@ -158,7 +158,8 @@ def test_from_standing_by_to_a_grasp_on_the_other_elbow_branch_the_elbow_turns_o
         )
         assert route is not None
         at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
-        assert all(np.allclose(route[0][k], q) for k, q in zip(at, passes)), "passes them"
+        pairs = zip(at, passes, strict=True)
+        assert all(np.allclose(route[0][k], q) for k, q in pairs), "passes them"
         assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
 
 
