@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from arm_poses import table
 from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, box_points, isolation_robot, pick_object
 from basket import assert_in_basket
 
@@ -97,8 +98,7 @@ def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket
     name = "mug_1"
     b, referee = pick_object(robot, name)
     assert b.held is not None
-    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
-    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
     filled = CollisionChecker(np.vstack([b.held.surroundings.points, board]))
     assert not filled.clearance_ok(dims.UR5_READY_Q)[0]
     assert not filled.clearance_ok(dims.UR5_HIGH_READY_Q)[0]

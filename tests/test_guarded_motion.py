@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from arm_poses import table
 from arm_setups import TABLE_FRONT, TABLE_TOP, isolation_robot, top_down
 
 from laserpick.behaviours import Behaviours
@@ -154,8 +155,7 @@ def test_with_both_ready_poses_filled_the_arm_stows_by_a_search(robot):
     """A table top at 1.06 m fills both ready poses' hands (the place on the 108 cm high
     table has just let go, its hand above it): the stow folds the arm away from where it
     is instead of finding no way."""
-    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
-    top = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    top = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
     checker = CollisionChecker(top)
     assert not checker.clearance_ok(dims.UR5_READY_Q)[0]
     assert not checker.clearance_ok(dims.UR5_HIGH_READY_Q)[0]

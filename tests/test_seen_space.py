@@ -11,6 +11,7 @@ import itertools
 
 import numpy as np
 import pytest
+from arm_poses import table
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -108,8 +109,7 @@ def test_from_standing_by_under_a_board_the_way_out_passes_its_exit(world):
     the unstow pose does. Where a ready pose is clear, the way is direct."""
     s = get_settings().motion
     standby, exit_ = dims.UR5_STANDBY_Q, dims.UR5_STANDBY_EXIT_Q
-    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
-    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
     boarded = world.with_points(board)
     via = (READY, dims.UR5_HIGH_READY_Q)
     assert not boarded.clearance_ok(np.array(via)).any()
@@ -140,8 +140,7 @@ def test_from_standing_by_to_a_grasp_on_the_other_elbow_branch_the_elbow_turns_o
     q_pre = ik_tcp(T, UNSTOW)[0]
     assert q_pre[2] < 0, "elbow down"
     via = (READY, dims.UR5_HIGH_READY_Q)
-    xs, ys = np.meshgrid(np.arange(1.35, 1.95, 0.01), np.arange(-0.6, 0.0, 0.01))
-    board = np.c_[xs.ravel(), ys.ravel(), np.full(xs.size, 1.06)]
+    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
     for points, passes in ((world.points, [standby, READY, UNSTOW]), (board, [standby, UNSTOW])):
         checker = CollisionChecker(points, filtered=True)
         route = transit_path(
