@@ -94,7 +94,7 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
 def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket(robot):
     """Parked at a shelf, whose boards fill both ready poses, the arm that has let go over
     the basket folds away from there, rather than end with the object in the basket and no
-    way to ready."""
+    way to ready; and stays there when the session then stands by."""
     name = "mug_1"
     b, referee = pick_object(robot, name)
     assert b.held is not None
@@ -107,6 +107,10 @@ def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket
     assert dropped.ok, dropped.failure
     robot.sleep(1.0)
     assert referee.in_basket(name)
+    assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
+    # The session stands by after a drop; from the stowed pose that would turn the elbow over
+    # again, so an arm at rest stays there.
+    assert b.stand_by().ok
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
 
 

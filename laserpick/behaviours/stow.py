@@ -9,7 +9,7 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.first_plan import at_pose
+from laserpick.pipeline.first_plan import at_pose, at_rest
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import timed
 
@@ -62,8 +62,10 @@ class Stowing(GuardedMotion):
     def stand_by(self, checker: CollisionChecker | None = None) -> Outcome:
         """Wait for the next pick folded back beside the scooter (`dims.UR5_STANDBY_Q`):
         out of the cameras' view, and a way to the ready poses that keeps the elbow up.
-        Stowed instead where no way there is found. checker: as for `go_ready`."""
-        if at_pose(self.current_q(), dims.UR5_STANDBY_Q):
+        Stowed instead where no way there is found. checker: as for `go_ready`. An arm
+        already at rest stays there: from the stowed pose (where `fold_away` left a drop that
+        found neither ready pose clear) the way to standing by turns the elbow over."""
+        if at_rest(self.current_q()):
             return Outcome()
         around = checker or CollisionChecker(np.zeros((0, 3)))
         out = self.go_to(dims.UR5_STANDBY_Q, around, "standing by", via=(dims.UR5_HIGH_READY_Q,))
