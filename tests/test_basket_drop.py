@@ -5,12 +5,21 @@ every miss."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
 import pytest
 from arm_poses import table
-from arm_setups import BEHAVIOUR, DATA, TABLE_TOP, box_points, isolation_robot, pick_object
+from arm_setups import (
+    BEHAVIOUR,
+    DATA,
+    SETTINGS,
+    TABLE_TOP,
+    box_points,
+    isolation_robot,
+    pick_object,
+)
 from basket import assert_in_basket
 
 from laserpick.behaviours import (
@@ -22,7 +31,7 @@ from laserpick.behaviours import (
     holds_over_basket,
     rank_drop_postures,
 )
-from laserpick.behaviours.drop_postures import clear_carrying
+from laserpick.behaviours.drop_postures import clear_carrying, reach_times
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -208,18 +217,56 @@ def test_a_drop_holds_over_the_opening_the_object_as_seen_not_the_part_guessed_p
 
 
 def test_an_object_that_fits_the_basket_from_few_upright_postures_may_also_be_laid_over_it():
-    """A 20 cm tall object held near one end fits inside the opening from one upright
+    """A 25 cm tall object held near one end fits inside the opening from one upright
     posture only; should no path reach that one, the tilted postures come next, rather than
     the object staying in the hand."""
-    payload = np.mgrid[-0.02:0.1001:0.02, -0.02:0.0401:0.02, -0.03:0.2001:0.02].reshape(3, -1).T
+    payload = np.mgrid[-0.02:0.1401:0.02, -0.02:0.0401:0.02, -0.03:0.2201:0.02].reshape(3, -1).T
     free = CollisionChecker(np.zeros((0, 3)))
     upright = [q for q in drop_candidates() if free.clearance_ok(q, payload=payload)[0]]
     assert 1 <= len(upright) < BEHAVIOUR.drop_tries
     drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
     assert any(np.allclose(drops[0], q) for q in upright)  # the upright one first
-    tilted = drops[len(upright) :]
-    assert tilted, "tilted postures follow"
-    assert not any(np.allclose(t, q) for t in tilted for q in drop_candidates())
+    # Next the laid-in and tilted ones that hold it inside, before any that reach past.
+    assert len(drops) >= BEHAVIOUR.drop_tries
+    grid = drop_candidates()
+    assert not any(np.allclose(t, q) for t in drops[1 : BEHAVIOUR.drop_tries] for q in grid)
+
+
+def test_the_carry_is_timed_by_the_tcp_arc_as_well_as_the_joints():
+    """The straight joint move that turns the arm's base 1 rad, the hand held out at ready,
+    takes as long as the slower of the turn at the carrying joint speed and the hand's arc
+    at the TCP cap near people."""
+    motion = SETTINGS.motion
+    turned = dims.UR5_READY_Q + [1.0, 0, 0, 0, 0, 0]
+    radius = np.linalg.norm(tcp_pose(dims.UR5_READY_Q)[:2, 3] - dims.ARM_MOUNT_POS[:2])
+    expected = max(1.0 / motion.carry_joint_speed, radius * 1.0 / motion.tcp_speed)
+    got = reach_times(dims.UR5_READY_Q, turned[None], motion.carry_joint_speed, motion.tcp_speed)
+    assert got[0] == pytest.approx(expected, rel=0.02)
+
+
+def test_of_two_drop_postures_alike_the_one_reached_sooner_ranks_first():
+    """A mug lifted from the isolation table: of postures that hold it alike (the same
+    fall, the same reach past the opening), the one the carry reaches sooner ranks first,
+    even where it is farther in joint space: the TCP's arc around the arm's mount is held to
+    the cap near people, and is most of a carry's time."""
+    motion = SETTINGS.motion
+    lifted = np.array([-0.26, -0.92, 1.15, 1.38, 1.66, 1.9])
+    mug = box_points((0.08, 0.08, 0.10), step=0.02)
+    free = CollisionChecker(np.zeros((0, 3)))
+    ranked = rank_drop_postures(drop_candidates(), lifted, free, mug, mug, BEHAVIOUR)
+    pairs = [
+        (a, b)
+        for (ka, a), (kb, b) in itertools.permutations(ranked, 2)
+        if ka[:4] == kb[:4] and np.abs(a - lifted).max() < np.abs(b - lifted).max() - 0.1
+    ]
+    times = [
+        reach_times(lifted, np.array(p), motion.carry_joint_speed, motion.tcp_speed) for p in pairs
+    ]
+    slower_nearer = [p for p, t in zip(pairs, times, strict=True) if t[0] > t[1] + 1.0]
+    assert slower_nearer, "some posture nearer in joint space is reached a second later"
+    for near, sooner in slower_nearer:
+        first = rank_drop_postures([near, sooner], lifted, free, mug, mug, BEHAVIOUR)[0][1]
+        np.testing.assert_array_equal(first, sooner)
 
 
 def test_a_box_held_near_its_end_fits_no_drop_posture_and_the_screen_says_so_first():

@@ -48,7 +48,12 @@ class BasketDrop(Carrying, Stowing):
         the basket that a path reaches."""
         b = self.settings.behaviour
         drops = drop_configurations(
-            self.current_q(), held.surroundings, held.points_tcp, held.as_seen_tcp, settings=b
+            self.current_q(),
+            held.surroundings,
+            held.points_tcp,
+            held.as_seen_tcp,
+            settings=b,
+            motion=self.settings.motion,
         )
         if not drops:
             msg = "The arm cannot hold the object over the basket; it keeps it."

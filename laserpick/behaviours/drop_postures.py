@@ -12,7 +12,7 @@ import numpy as np
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import PAYLOAD_POINT_RADIUS, CollisionChecker, held_at
-from laserpick.settings import BehaviourSettings, get_settings
+from laserpick.settings import BehaviourSettings, MotionSettings, get_settings
 from laserpick.transforms import roty, rotz
 
 __all__ = [
@@ -26,7 +26,7 @@ __all__ = [
     "rank_drop_postures",
 ]
 
-#: A rank key: (past the opening?, coarse fall, steps past, fall, nearness to the reference).
+#: A rank key: (past the opening?, coarse fall, steps past, fall, time to reach it).
 DropRank = tuple[int, int, int, int, float]
 #: Postures checked at once: the check's arrays grow with postures x payload points x spheres.
 CHUNK = 64
@@ -35,6 +35,8 @@ CHUNK = 64
 #: the postures it clears are checked again with every point: the same verdict, sooner where
 #: most postures fail, as they do for a long box held near its end.
 COARSE_PAYLOAD = 0.05
+#: Configurations along the straight joint move whose TCP arc `reach_times` sums.
+REACH_SAMPLES = 16
 
 
 def drop_candidates(
@@ -43,12 +45,14 @@ def drop_candidates(
     """Joint configurations for releasing over the basket, the arm clear of the scooter (rad).
 
     Upright (the default): the TCP over (or just inside) the basket's opening, the gripper
-    pointing down or tilted up to 30 deg. Tilted: the gripper tilted 45-90 deg from down,
-    toward any side, its TCP up to 20 cm beside the opening: for a tall object held at its
-    top, which hangs too deep below a downward hand for any reachable height (the arm
-    reaches at most 26 cm above the rim pointing down), so it is laid over the opening
-    instead. heights: the TCP's heights over the rim (m; default: the settings'
-    `drop_heights`). Computed once for each: the basket is fixed to the scooter.
+    pointing down or tilted up to 30 deg, turned any way about its axis (a half turn holds
+    the object the other way round, and may leave the wrist less to turn). Tilted: the
+    gripper tilted 45-90 deg from down, toward any side, its TCP up to 20 cm beside the
+    opening: for a tall object held at its top, which hangs too deep below a downward hand
+    for any reachable height (the arm reaches at most 26 cm above the rim pointing down), so
+    it is laid over the opening instead. heights: the TCP's heights over the rim (m;
+    default: the settings' `drop_heights`). Computed once for each: the basket is fixed to
+    the scooter.
     """
     if heights is None:
         heights = get_settings().behaviour.drop_heights
@@ -81,7 +85,7 @@ def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarr
             np.linspace(-0.3, 0.3, 3) * inner[0],
             np.linspace(-0.3, 0.3, 3) * inner[1],
             heights,
-            np.radians(np.arange(0, 180, 30)),
+            np.radians(np.arange(0, 360, 30)),
             np.radians((0, 15, 30)),
         )
     out = []
@@ -101,6 +105,7 @@ def drop_configurations(
     falls: np.ndarray | None = None,
     *,
     settings: BehaviourSettings,
+    motion: MotionSettings | None = None,
 ) -> list[np.ndarray]:
     """Clear joint configurations that hold the object over the basket's opening, best
     first (rad): those of `drop_candidates()`, and where fewer than `drop_tries` of them
@@ -112,25 +117,26 @@ def drop_configurations(
     falls (F, 3), TCP frame (m): the object as it falls when let go (default `payload`):
     less the part that stands in for what the view cut off (`Held.as_seen_tcp`), which
     would pull the middle it is held by off the real object's, and let it fall beside the
-    basket.
+    basket. motion: the carrying limits the ranking times the way there by (default: the
+    settings').
 
-    Postures that hold every point of the object inside the opening (1 cm in from the
-    walls) come first, upright before laid in and tilted, each by the shortest fall (in
-    `fall_step` steps: a long fall bounces the object out), then the nearest to q_ref. Then
-    those that hold its middle there, upright and tilted together (`rank_drop_postures`).
-    A posture that does not hold even the middle over the opening is left out: an object
-    let go there would fall beside the basket, onto the scooter or the floor. So is one
-    that holds any of it past the opening's back edge, over the tiller and the rider's
-    hands. Empty when none is left.
-    The basket sits close beside the arm's base, between the tiller, the sensor posts and
-    the projector, so few postures reach over it: they are searched, not assumed.
+    Postures that hold every point of the object inside the opening (1 cm in from the walls)
+    come first, upright before laid in and tilted, each by the shortest fall (in `fall_step`
+    steps: a long fall bounces the object out), then the soonest reached from q_ref
+    (`reach_times`). Then those that hold its middle there, upright and tilted together
+    (`rank_drop_postures`). A posture that does not hold even the middle over the opening is
+    left out: an object let go there would fall beside the basket, onto the scooter or the
+    floor. So is one that holds any of it past the opening's back edge, over the tiller and
+    the rider's hands. Empty when none is left. The basket sits close beside the arm's base,
+    between the tiller, the sensor posts and the projector, so few postures reach over it:
+    they are searched, not assumed.
     """
     falls = payload if falls is None else falls
     upright, *others = _posture_families(payload, falls, q_ref, checker.margin, settings)
-    ranked = rank_drop_postures(upright(), q_ref, checker, payload, falls, settings)
+    ranked = rank_drop_postures(upright(), q_ref, checker, payload, falls, settings, motion)
     if sum(key[0] == 0 for key, _ in ranked) < settings.drop_tries:
         for more in others:
-            ranked += rank_drop_postures(more(), q_ref, checker, payload, falls, settings)
+            ranked += rank_drop_postures(more(), q_ref, checker, payload, falls, settings, motion)
         inside = [kq for kq in ranked if kq[0][0] == 0]
         past = sorted((kq for kq in ranked if kq[0][0] != 0), key=lambda kq: kq[0])
         ranked = inside + past
@@ -268,14 +274,16 @@ def rank_drop_postures(
     payload: np.ndarray,
     falls: np.ndarray,
     settings: BehaviourSettings,
+    motion: MotionSettings | None = None,
 ) -> list[tuple[DropRank, np.ndarray]]:
     """The clear `candidates` (clear with `payload`, TCP frame, m) that hold the middle of
     the object as it falls (`falls`, TCP frame, m) over the opening, and none of it past the
     opening's back edge, toward the rider, each with its rank key, sorted. Wholly inside the
-    opening: (0, 0, 0, fall, nearness); partly past it: (1, coarse fall, steps past, fall,
-    nearness). The fall is the object's lowest point over the basket's floor in `fall_step`
+    opening: (0, 0, 0, fall, time); partly past it: (1, coarse fall, steps past, fall,
+    time). The fall is the object's lowest point over the basket's floor in `fall_step`
     steps (coarse: `overhang_fall_step`), the reach past the opening in `overhang_step`
-    steps, and nearness the largest joint's distance from `q_ref` (rad)."""
+    steps, and time how long the carry there from `q_ref` takes (`reach_times`, s, at the
+    carrying limits of `motion`; default: the settings')."""
     if not candidates:
         return []
     floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
@@ -295,15 +303,32 @@ def rank_drop_postures(
     drop = held[..., 2].min(axis=1) - floor
     fall = (drop // settings.fall_step).astype(int)
     coarse = (drop // settings.overhang_fall_step).astype(int)
-    near = np.max(np.abs(Q - q_ref), axis=1)
+    motion = motion or get_settings().motion
+    soon = reach_times(q_ref, Q, motion.carry_joint_speed, motion.tcp_speed)
     ranked = [
         (
-            (0, 0, 0, int(fall[i]), float(near[i]))
+            (0, 0, 0, int(fall[i]), float(soon[i]))
             if past[i] == 0
-            else (1, int(coarse[i]), int(past[i]), int(fall[i]), float(near[i])),
+            else (1, int(coarse[i]), int(past[i]), int(fall[i]), float(soon[i])),
             Q[i],
         )
         for i in np.flatnonzero(clear)
     ]
     ranked.sort(key=lambda kq: kq[0])
     return ranked
+
+
+def reach_times(
+    q_ref: np.ndarray, Q: np.ndarray, joint_speed: float, tcp_speed: float
+) -> np.ndarray:
+    """(B,) how long (s) the straight joint move from q_ref (6,) to each of Q (B, 6) (rad)
+    takes at `joint_speed` (rad/s) and `tcp_speed` (m/s), the slower of the two; no
+    acceleration. The TCP arc counts: a posture a little nearer in joint space may swing the
+    hand around the arm's mount, and the carry is held to the TCP cap near people."""
+    if len(Q) == 0:
+        return np.zeros(0)
+    s = np.linspace(0.0, 1.0, REACH_SAMPLES)[None, :, None]
+    path = q_ref[None, None] + s * (Q - q_ref)[:, None]  # (B, S, 6)
+    tcp = tcp_pose(path)[..., :3, 3]
+    arc = np.linalg.norm(np.diff(tcp, axis=1), axis=-1).sum(axis=1)
+    return np.maximum(np.abs(Q - q_ref).max(axis=1) / joint_speed, arc / tcp_speed)
