@@ -32,6 +32,7 @@ from laserpick.behaviours import (
     rank_drop_postures,
 )
 from laserpick.behaviours.drop_postures import clear_carrying, reach_times
+from laserpick.behaviours.laid_in import hand_down_turns
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -40,6 +41,7 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.transforms import rotz
 
 
 @pytest.fixture
@@ -230,6 +232,26 @@ def test_an_object_that_fits_the_basket_from_few_upright_postures_may_also_be_la
     assert len(drops) >= BEHAVIOUR.drop_tries
     grid = drop_candidates()
     assert not any(np.allclose(t, q) for t in drops[1 : BEHAVIOUR.drop_tries] for q in grid)
+
+
+def test_a_box_held_askew_is_squared_with_the_basket_and_laid_wholly_in():
+    """A cereal box (25 x 6 x 19 cm) gripped at its near edge, 7 cm below its top, the grip
+    10 deg askew about the hand's axis, as from the bookshelf's top board: no upright posture
+    holds it inside the opening, nor fits its outline there with the hand pointing down. The
+    hand that lines the box's own axes up with the basket's lays it wholly in, low."""
+    box = np.mgrid[-0.07:0.1801:0.01, -0.03:0.0301:0.01, -0.03:0.1601:0.01].reshape(3, -1).T
+    payload = box @ rotz(math.radians(10.0)).T
+    free = CollisionChecker(np.zeros((0, 3)))
+    upright = rank_drop_postures(
+        drop_candidates(), dims.UR5_READY_Q, free, payload, payload, BEHAVIOUR
+    )
+    assert not any(key[0] == 0 for key, _ in upright)
+    drops = drop_configurations(dims.UR5_READY_Q, free, payload, settings=BEHAVIOUR)
+    assert drops
+    past, fall = past_and_fall(drops[0], payload)
+    assert past == 0 and fall <= max(BEHAVIOUR.drop_lows) + 1e-6
+    turn = tcp_pose(drops[0])[:3, :3]
+    assert not any(np.allclose(turn, R, atol=1e-6) for R in hand_down_turns())
 
 
 def test_the_carry_is_timed_by_the_tcp_arc_as_well_as_the_joints():

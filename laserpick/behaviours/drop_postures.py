@@ -9,9 +9,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from laserpick.behaviours.laid_in import DOWN, laid_in_candidates, scooter_only
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline.collision import PAYLOAD_POINT_RADIUS, CollisionChecker, held_at
+from laserpick.pipeline.collision import CollisionChecker, held_at
 from laserpick.settings import BehaviourSettings, MotionSettings, get_settings
 from laserpick.transforms import roty, rotz
 
@@ -21,9 +22,9 @@ __all__ = [
     "drop_candidates",
     "drop_configurations",
     "holds_over_basket",
-    "laid_in_candidates",
     "past_the_opening",
     "rank_drop_postures",
+    "reach_times",
 ]
 
 #: A rank key: (past the opening?, coarse fall, steps past, fall, time to reach it).
@@ -60,17 +61,10 @@ def drop_candidates(
 
 
 @functools.cache
-def _scooter_only(margin: float = 0.01) -> CollisionChecker:
-    """A checker with no cloud: the arm against the scooter, its rider and itself, keeping
-    `margin` (m) of clearance."""
-    return CollisionChecker(np.zeros((0, 3)), margin=margin)
-
-
-@functools.cache
 def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarray, ...]:
     centre, inner = dims.BASKET_CENTER, dims.BASKET_INNER
     rim = centre[2] + inner[2] / 2
-    free = _scooter_only()
+    free = scooter_only()
     if tilted:
         offsets = np.linspace(-0.2, 0.2, 5)
         grid = itertools.product(
@@ -91,7 +85,7 @@ def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarr
     out = []
     for dx, dy, dz, yaw, tilt in grid:
         T = np.eye(4)
-        T[:3, :3] = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down
+        T[:3, :3] = rotz(yaw) @ roty(tilt) @ DOWN
         T[:3, 3] = [centre[0] + dx, centre[1] + dy, rim + dz]
         Q = ik_tcp(T, dims.UR5_READY_Q)
         out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
@@ -161,7 +155,7 @@ def holds_over_basket(
     postures are checked a chunk at a time, upright, laid in, then tilted, and the answer
     is yes at the first that holds it."""
     falls = payload if falls is None else falls
-    free = _scooter_only(margin)
+    free = scooter_only(margin)
     q_ref = dims.UR5_READY_Q
     for family in _posture_families(payload, falls, q_ref, margin, settings):
         candidates = family()
@@ -211,45 +205,6 @@ def _one_per_cell(points: np.ndarray, cell: float) -> np.ndarray:
         return points
     _, first = np.unique(np.floor(points / cell).astype(np.int64), axis=0, return_index=True)
     return points[np.sort(first)]
-
-
-def laid_in_candidates(
-    held: np.ndarray, q_ref: np.ndarray, lows: Sequence[float], margin: float
-) -> list[np.ndarray]:
-    """Joint configurations (rad) that lay the held object (`held`, its points (P, 3) in
-    the TCP frame, m: as carried and as it falls) into the basket, low: its lowest point
-    `lows` (m) over the basket's floor, its outline within the opening and `margin` (m, the
-    clearance the check keeps) off the walls, at the middle and at either side of the room
-    it has there, the hand pointing down or tilted up to 30 deg, turned any way. Only turns
-    whose outline fits the opening are tried, and only configurations clear of the scooter
-    are kept (the object itself is checked when they are ranked).
-
-    The fixed grid of `drop_candidates` places the hand, not the object: a cereal box held
-    1.4 cm off its middle reached 3 mm past the opening from every posture of the grid that
-    turned it the right way, and was let go across the rims from higher up instead."""
-    if len(held) == 0:
-        return []
-    half = dims.BASKET_INNER[:2] / 2 - max(margin + PAYLOAD_POINT_RADIUS, 0.01)
-    lo, hi = dims.BASKET_CENTER[:2] - half, dims.BASKET_CENTER[:2] + half
-    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
-    free = _scooter_only()
-    out: list[np.ndarray] = []
-    for yaw, tilt in itertools.product(np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30))):
-        R = rotz(yaw) @ roty(tilt) @ np.diag([1.0, -1.0, -1.0])  # approach down, then turned
-        turned = held @ R.T
-        low, high = turned.min(axis=0), turned.max(axis=0)
-        room = (hi - lo) - (high - low)[:2]
-        if (room < 0).any():
-            continue
-        # In whole cm, rounded down: a spot never reaches past the room it has.
-        spots = itertools.product(*(np.unique(np.floor([0, 50 * r, 100 * r]) / 100) for r in room))
-        for (sx, sy), above in itertools.product(spots, lows):
-            T = np.eye(4)
-            T[:3, :3] = R
-            T[:3, 3] = [lo[0] + sx - low[0], lo[1] + sy - low[1], floor + above - low[2]]
-            Q = ik_tcp(T, q_ref)
-            out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]
-    return out
 
 
 def basket_opening() -> tuple[np.ndarray, np.ndarray]:
