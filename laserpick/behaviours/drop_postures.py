@@ -46,8 +46,9 @@ def drop_candidates(
     """Joint configurations for releasing over the basket, the arm clear of the scooter (rad).
 
     Upright (the default): the TCP over (or just inside) the basket's opening, the gripper
-    pointing down or tilted up to 30 deg, turned any way about its axis (a half turn holds
-    the object the other way round, and may leave the wrist less to turn). Tilted: the
+    pointing down or tilted up to 30 deg, turned about its axis in 30 deg steps over half a
+    turn (the other half holds the object the other way round: with it, a pill bottle lying
+    in the hand was let go half turned and missed the basket, not traced). Tilted: the
     gripper tilted 45-90 deg from down, toward any side, its TCP up to 20 cm beside the
     opening: for a tall object held at its top, which hangs too deep below a downward hand
     for any reachable height (the arm reaches at most 26 cm above the rim pointing down), so
@@ -79,7 +80,7 @@ def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarr
             np.linspace(-0.3, 0.3, 3) * inner[0],
             np.linspace(-0.3, 0.3, 3) * inner[1],
             heights,
-            np.radians(np.arange(0, 360, 30)),
+            np.radians(np.arange(0, 180, 30)),
             np.radians((0, 15, 30)),
         )
     out = []
