@@ -59,8 +59,9 @@ def test_a_dropped_connection_is_silence_at_once(clock: Clock) -> None:
     token = lease.acquire("a", "rest")
     clock.now += 0.1
     assert lease.silent_for(token) == pytest.approx(0.1)
+    assert lease.heard_at(token) == 100.0  # when it was taken, not how long ago
     lease.connection_lost(token)
-    assert lease.silent_for(token) == math.inf
+    assert lease.silent_for(token) == math.inf and lease.heard_at(token) == -math.inf
     assert lease.heartbeat(token)  # it came back
     assert lease.silent_for(token) == 0.0
 

@@ -464,6 +464,32 @@ def test_an_object_with_no_way_to_the_basket_from_where_it_was_lifted_is_tucked_
         session.close()
 
 
+def test_the_dead_man_is_handed_over_again_only_when_the_holder_is_heard_again() -> None:
+    """While a drive runs and its holder says nothing, the controller keeps the one deadline
+    it was handed: the watchdog's tick posts nothing to the sim thread until the holder is
+    heard from again."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    pushed: list[float | None] = []
+    arm = session.robot.deadman
+
+    def recording(until: float | None) -> None:
+        pushed.append(until)
+        arm(until)
+
+    session.robot.deadman = recording  # type: ignore[method-assign]
+    try:
+        actor = Actor("console", session.lease.acquire("test", "console"))
+        session.drive(actor, 0.2, 0.0, 0.5)
+        time.sleep(0.3)  # 15 watchdog ticks, short of the 0.5 s of silence that halts
+        armed = [u for u in pushed if u is not None]
+        assert len(armed) == 1, armed
+        session.lease.heartbeat(actor.token)
+        time.sleep(0.1)
+        assert len([u for u in pushed if u is not None]) == 2, pushed
+    finally:
+        session.close()
+
+
 def test_the_dead_man_is_reckoned_from_the_last_sign_of_life_never_from_now() -> None:
     """While a lease holder's drive runs, every deadline the watchdog hands the controller
     is at most `watchdog_s` after the holder was last heard, so a watchdog running late

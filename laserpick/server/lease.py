@@ -5,10 +5,10 @@ A client takes the lease and gets a random token; it proves itself on every comm
 `{"type": "heartbeat"}` messages, or `POST /api/v1/control` again with its token). Without a
 heartbeat for `timeout` seconds the lease lapses and anyone may take it. Others may watch.
 
-The lease also tells the session's watchdog whether the controller is still there: `silent_for`
-is the time since its last sign of life, and a dropped controlling websocket counts as silence
-from that moment (`connection_lost`), so motion stops at the watchdog's next tick instead of
-after the heartbeat window.
+The lease also tells the session's watchdog whether the controller is still there:
+`heard_at` is the time of its last sign of life (`silent_for` the time since), and a dropped
+controlling websocket counts as silence from that moment (`connection_lost`), so motion
+stops at the watchdog's next tick instead of after the heartbeat window.
 
 Times are `time.monotonic()` seconds. Thread-safe.
 """
@@ -131,14 +131,19 @@ class ControlLease:
         with self._lock:
             return self._valid(token, self._clock())
 
+    def heard_at(self, token: str) -> float:
+        """When (the clock's s) `token`'s holder last showed life; -inf if it no longer holds
+        the lease or its connection dropped. The same value until it is heard again, so a
+        deadline reckoned from it moves only then."""
+        with self._lock:
+            if self._lost or not self._valid(token, self._clock()):
+                return -math.inf
+            return self._last
+
     def silent_for(self, token: str) -> float:
         """Seconds since `token`'s holder last showed life; infinite if it no longer holds
         the lease or its connection dropped."""
-        with self._lock:
-            now = self._clock()
-            if self._lost or not self._valid(token, now):
-                return math.inf
-            return now - self._last
+        return self._clock() - self.heard_at(token)
 
     def info(self) -> LeaseInfo:
         with self._lock:

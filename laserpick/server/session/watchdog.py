@@ -74,7 +74,7 @@ class Watchdog(SessionCore):
                 self._disarm()
             return
         limit = self.settings.server.watchdog_s
-        heard = min(now - self.lease.silent_for(t) for t in tokens)
+        heard = min(self.lease.heard_at(t) for t in tokens)
         if heard + limit <= now:
             self._halt_motion(SILENT_REASON)
         elif self._deadline is not None and self._deadline <= now:
