@@ -223,6 +223,27 @@ def test_the_force_felt_adds_forces_as_vectors_body_by_body(sim):
     assert sim.felt(two) == pytest.approx(70.0)
 
 
+def test_a_dead_man_halt_while_driving_is_told_to_the_consoles():
+    """The dead-man halting a driving scooter leaves the reason where the consoles show why
+    the scooter stopped (`drive_stop`): otherwise a drive cut short by a silent controller
+    ends without a word."""
+    s = Simulation(load_scene("isolation"), realtime=True)
+    s.start()
+    try:
+        time.sleep(0.2)
+        s.drive(0.2, 0.0, 0.5)
+        s.deadman(time.monotonic() + 0.1)
+        give_up = time.monotonic() + 10.0
+        while not s.snapshot().drive_stop and time.monotonic() < give_up:
+            time.sleep(0.01)
+        snap = s.snapshot()
+        assert "dead-man" in snap.drive_stop and snap.drive_stop.startswith("The scooter stopped")
+        time.sleep(0.1)
+        assert np.max(np.abs(s.snapshot().base_velocity)) < 0.01
+    finally:
+        s.close()
+
+
 def test_the_controllers_dead_man_halts_at_its_deadline_by_itself():
     """Armed and never renewed, the dead-man halts a running trajectory within one physics
     step of its deadline with nobody else acting, refuses motion while tripped, and lets

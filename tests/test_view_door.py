@@ -295,7 +295,8 @@ def test_the_operator_page_s_view_acts_under_its_lease(site, browser) -> None:
         view.get_by_role("button", name="Back", exact=True).click(timeout=60_000)
         # Any motion back is the view's command obeyed, which is what this test is about: a
         # pad step drives 10 cm on an idle machine, and has ended after 1-6 mm on a starved
-        # one (two busy loops beside the test).
+        # one (two busy loops beside the test), where the page's heartbeats came late and the
+        # dead-man halted the step at its end in wall time, the simulation far behind.
         api.wait_for(lambda s: s["base_pose"][0] < start["base_pose"][0] - 5e-4, timeout=10)
         time.sleep(4.0)  # the scene fades in after the view reopened
         box = view.locator("canvas").first.bounding_box()

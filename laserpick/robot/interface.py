@@ -95,7 +95,8 @@ class RobotState:
 
     stamp: robot time (s). base_pose: odometry (x, y, yaw) in m and rad since start.
     base_velocity: forward speed (m/s) and turn rate (rad/s). estopped: the e-stop is latched.
-    moving: an arm motion is in progress. drive_stop: why the base last stopped itself, or "".
+    moving: an arm motion is in progress. drive_stop: why the base last stopped itself or was
+    halted (the dead-man) while driving, or "".
     rtf: robot seconds per wall second (1.0 for hardware and for a simulator keeping up).
     read_at: wall-clock time (s since the epoch) the reading stands for.
     """

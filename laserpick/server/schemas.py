@@ -248,7 +248,8 @@ class Status(BaseModel):
     estopped: bool
     drive_stop: str | None = Field(
         description="Why the scooter stopped itself while driving (it pushed the still arm "
-        "into something), until it drives freely again."
+        "into something) or was halted (the dead-man: its controller went silent), until it "
+        "drives freely again."
     )
     sim_time: float
     rtf: float

@@ -29,7 +29,8 @@ class BaseDrive:
 
     `command` is the last (v m/s, w rad/s) asked for, held until `deadline` (sim s); `now` the
     ramped (v, w) the base servos follow. `stop_reason` says why the scooter last stopped
-    itself while driving, until it has driven freely for `DRIVE_STOP_CLEARS`; "" otherwise.
+    itself, or was halted, while driving, until it has driven freely for `DRIVE_STOP_CLEARS`;
+    "" otherwise.
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, info: ModelInfo) -> None:
@@ -88,6 +89,15 @@ class BaseDrive:
         self.stopped_at = self.data.time
         self.stop()
         return True
+
+    def halted(self, why: str) -> None:
+        """Stop the scooter this step for `why` (a controller's halt); a scooter that was
+        driving says so in `stop_reason`, which the consoles show: a halt by the dead-man
+        while driving otherwise stops it without a word."""
+        if self.now.any() or self.data.time < self.deadline:
+            self.stop_reason = f"The scooter stopped: {why}."
+            self.stopped_at = self.data.time
+        self.stop()
 
     def stop(self) -> None:
         """Stop the scooter this step, and drop the drive command."""

@@ -352,6 +352,7 @@ class Simulation:
             return
         if max(time.monotonic(), self._stands_for()) >= until:
             self.deadman_tripped = True
+            self._drive.halted(DEADMAN_STOP)
             self._halt("stopped", DEADMAN_STOP)
 
     def _drain(self) -> None:
