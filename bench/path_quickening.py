@@ -36,7 +36,7 @@ def main() -> None:
     for f in files:
         q0, q1, checker, kw = load_search(f)
         carry = kw.get("payload") is not None
-        speed = s.carry_joint_speed if carry else s.joint_speed
+        speed = s.joint_speed_for(carrying=carry)
         t = time.perf_counter()
         rng = np.random.default_rng(0)
         found = rrt_connect(

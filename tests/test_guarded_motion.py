@@ -72,6 +72,25 @@ def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robo
     assert b.run(timed(np.stack([robot.joint_state().q, q_high]), b.settings.motion), "") is None
 
 
+def test_the_way_back_after_a_protective_stop_keeps_the_carrying_speed(robot):
+    """Holding something, the arm goes back the way it came no faster than it carries."""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    T_low = tcp_pose(dims.UR5_READY_Q)
+    T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.15]  # 15 cm into the table
+    q_low = ik_tcp(T_low, dims.UR5_READY_Q)[0]
+    move = timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion)
+    ran: list[Trajectory] = []
+    execute = robot.execute
+    robot.execute = lambda traj: ran.append(traj) or execute(traj)
+    b.held = object()  # only whether the hand holds something matters here
+    failure = b.run(move, "carrying")
+    assert failure is not None and failure.message.endswith("stopped and backed away.")
+    way_back = ran[-1]
+    speeds = np.abs(np.diff(way_back.q, axis=0)) / np.diff(way_back.times)[:, None]
+    assert speeds.max() <= b.settings.motion.carry_joint_speed * 1.001
+
+
 def test_the_scooter_stops_when_it_drives_the_still_arm_into_something(robot):
     """The arm holds still with the hand low before the table's front edge, and the user
     drives at it, the stick held: the scooter stops each time it pushes the arm harder than

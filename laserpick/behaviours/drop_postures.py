@@ -260,7 +260,7 @@ def rank_drop_postures(
     fall = (drop // settings.fall_step).astype(int)
     coarse = (drop // settings.overhang_fall_step).astype(int)
     motion = motion or get_settings().motion
-    soon = reach_times(q_ref, Q, motion.carry_joint_speed, motion.tcp_speed)
+    soon = reach_times(q_ref, Q, motion.joint_speed_for(carrying=True), motion.tcp_speed)
     ranked = [
         (
             (0, 0, 0, int(fall[i]), float(soon[i]))

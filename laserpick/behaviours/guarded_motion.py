@@ -102,7 +102,8 @@ class GuardedMotion:
         the arm was there a moment ago, so that way is clear, and the arm is then neither
         pressed against what it met nor left standing in the cameras' view (where it hides
         the next mark's object from them). Not when the user has cancelled: the arm then
-        stays where it stopped. Returns whether it got back."""
+        stays where it stopped. Holding something, it goes back at the carrying speed.
+        Returns whether it got back."""
         if self.should_stop():
             return False
         b = self.settings.behaviour
@@ -115,7 +116,8 @@ class GuardedMotion:
         path = back[np.union1d(keep, [len(back) - 1])]
         if len(path) < 2 or np.max(np.abs(path[-1] - q)) < b.start_tolerance:
             return True
-        way_back = timed(path, self.settings.motion)
+        s = self.settings.motion
+        way_back = timed(path, s, joint_speed=s.joint_speed_for(carrying=self.held is not None))
         handle = self.robot.execute(way_back)
         return self.robot.wait(handle, way_back.duration + b.motion_slack) == "done"
 
@@ -130,7 +132,7 @@ class GuardedMotion:
         """A collision-free joint move to q_goal (6,) rad; when no path is found, through
         each configuration of `via` in turn (two shorter searches instead of one long).
         kw: passed to `joint_path` (`payload`, TCP frame: what the hand carries, which also
-        slows the move to `carry_joint_speed`)."""
+        slows the move to the carrying speed, `joint_speed_for`)."""
         s, q = self.settings.motion, self.current_q()
         path = joint_path(q, q_goal, checker, self.rng, s, **kw)
         for q_via in via:
@@ -143,8 +145,7 @@ class GuardedMotion:
             path = None if second is None else np.vstack([first, second[1:]])
         if path is None:
             return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
-        carrying = kw.get("payload") is not None
-        speed = s.carry_joint_speed if carrying else None
+        speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
 
         def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
             return checker.clearance_ok(Q, **kw)

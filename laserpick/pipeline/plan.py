@@ -75,7 +75,7 @@ def joint_path(
     if path is None or not s.quicken_paths:
         return path
     # A carry runs at the carrying speed (`GuardedMotion.go_to`): so is its path quickened.
-    speed = s.carry_joint_speed if kw.get("payload") is not None else s.joint_speed
+    speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
     quick = quicken(path, checker, rng, joint_speed=speed, tcp_speed=s.tcp_speed, **kw)
     quick = shortcut(quick, checker, rng, **kw)
     # The estimate `quicken` goes by leaves out the corners; the timing itself decides.

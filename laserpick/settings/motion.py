@@ -180,3 +180,8 @@ class MotionSettings(BaseModel):
                 f" {self.regrip_lift}, {self.lift_least}, {self.lift_low}, {self.lift}"
             )
         return self
+
+    def joint_speed_for(self, carrying: bool) -> float:
+        """The joint speed limit (rad/s) of a move: `carry_joint_speed` while the hand
+        carries something, else `joint_speed`. Every move the arm runs asks here."""
+        return min(self.carry_joint_speed, self.joint_speed) if carrying else self.joint_speed
