@@ -44,16 +44,22 @@ def test_guarded_trajectory_stops_on_contact(robot):
     assert tcp_z > TABLE_TOP - 0.03, "it stopped at the table, not inside it"
 
 
+def _through_the_table(robot) -> tuple[Behaviours, Trajectory]:
+    """The arm at ready, and an unguarded joint move that drives its hand 15 cm into the
+    table."""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    T_low = tcp_pose(dims.UR5_READY_Q)
+    T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.15]
+    q_low = ik_tcp(T_low, dims.UR5_READY_Q)[0]
+    return b, timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion)
+
+
 def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robot):
     """An unguarded joint move that drives the hand down through the table (as a transit
     planned through unseen furniture would) is stopped by the protective stop; the arm goes
     back the way it came, and the behaviour says so in words."""
-    b = Behaviours(robot)
-    assert b.go_ready().ok
-    T_low = tcp_pose(dims.UR5_READY_Q)
-    T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.15]  # 15 cm into the table
-    q_low = ik_tcp(T_low, dims.UR5_READY_Q)[0]
-    move = timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion)
+    b, move = _through_the_table(robot)
     lowest = []
     robot.sim.on_snapshot(lambda snap: lowest.append(tcp_pose(snap.arm_q)[2, 3]))
     failure = b.run(move, "testing")
@@ -67,19 +73,15 @@ def test_any_motion_pushed_back_hard_makes_a_protective_stop_and_backs_away(robo
     assert np.abs(s.arm_qd).max() < 0.05, "the arm must be at rest after backing away"
     assert np.max(np.abs(s.arm_q - dims.UR5_READY_Q)) < 0.05, "back where the move started"
     # It stops on the push, not before: the same move above the table finishes.
-    T_low[2, 3] = TABLE_TOP + 0.15
-    q_high = ik_tcp(T_low, dims.UR5_READY_Q)[0]
+    T_high = tcp_pose(dims.UR5_READY_Q)
+    T_high[:3, 3] = [1.5, -0.3, TABLE_TOP + 0.15]
+    q_high = ik_tcp(T_high, dims.UR5_READY_Q)[0]
     assert b.run(timed(np.stack([robot.joint_state().q, q_high]), b.settings.motion), "") is None
 
 
 def test_the_way_back_after_a_protective_stop_keeps_the_carrying_speed(robot):
     """Holding something, the arm goes back the way it came no faster than it carries."""
-    b = Behaviours(robot)
-    assert b.go_ready().ok
-    T_low = tcp_pose(dims.UR5_READY_Q)
-    T_low[:3, 3] = [1.5, -0.3, TABLE_TOP - 0.15]  # 15 cm into the table
-    q_low = ik_tcp(T_low, dims.UR5_READY_Q)[0]
-    move = timed(np.stack([robot.joint_state().q, q_low]), b.settings.motion)
+    b, move = _through_the_table(robot)
     ran: list[Trajectory] = []
     execute = robot.execute
     robot.execute = lambda traj: ran.append(traj) or execute(traj)
