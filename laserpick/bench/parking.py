@@ -9,6 +9,7 @@ middle and y across.
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 from collections.abc import Sequence
 
@@ -21,6 +22,10 @@ from laserpick.bench.route_planning import Footprint, Outline, parked_clear, pla
 from laserpick.description import dims
 from laserpick.robot.sim.scenes import Scene, Surface
 
+log = logging.getLogger(__name__)
+
+#: m above the floor within which an object's lowest point lies on it.
+FLOOR_LYING = 0.05
 #: m behind a surface's front edge that the user parks to work at (the isolation table's
 #: objects stand 5-45 cm behind its edge at 1.30 m).
 PARK_SPOT_DEPTH = 0.25
@@ -93,7 +98,7 @@ def obstacles(
     out: list[Surface | Footprint] = [s for s in surfaces if s.kind != "floor"]
     for name in keep_off:
         world = referee.object_points(name, frame="world")
-        if world[:, 2].min() > 0.05:  # not on the floor
+        if world[:, 2].min() > FLOOR_LYING:  # not on the floor
             continue
         lo, hi = world[:, :2].min(axis=0), world[:, :2].max(axis=0)
         out.append(Footprint(name, tuple((lo + hi) / 2), 0.0, tuple(hi - lo)))
@@ -142,18 +147,52 @@ def park(
     ways = itertools.product(FLOOR_ACROSS, FLOOR_TURNS) if floor else [(0.0, 0.0)]
     ways = [(across + a, turn) for a, turn in ways]
     outline = outline or op.referee.outline()
-    around = _scene_obstacles(op, scene)
     parked_at = () if works_at is None else (works_at,)
-    others = [a for a in around if a.name not in parked_at]
-    for across, turn in ways:
-        goal = parking_pose(
-            surface, local_y, level, local_x=local_x, turn=turn, back=back, across=across
-        )
-        if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
-            return True
-        if not parked_clear(goal, others, outline):
-            continue
-        plan = plan_drive(op.base_pose(), goal, around, outline, 0.6, parked_at)
-        if plan is not None:
-            return follow(op, goal, *plan)
+    for cleared in (False, True):
+        if cleared:  # as a person would ask: someone picks up what fell, and they try again
+            down = fallen(scene, op.referee)
+            if not down:
+                return False
+            for name in down:
+                op.referee.take_out(name)
+            log.info("the floor cleared of %s, which kept the user from parking", down)
+        around = _scene_obstacles(op, scene)
+        others = [a for a in around if a.name not in parked_at]
+        for across, turn in ways:
+            goal = parking_pose(
+                surface, local_y, level, local_x=local_x, turn=turn, back=back, across=across
+            )
+            if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
+                return True
+            if not parked_clear(goal, others, outline):
+                continue
+            plan = plan_drive(op.base_pose(), goal, around, outline, 0.6, parked_at)
+            if plan is not None:
+                return follow(op, goal, *plan)
     return False
+
+
+def fallen(scene: Scene, referee: Referee) -> list[str]:
+    """The objects lying on the floor outside every floor area, where nobody puts anything
+    down: dropped on the way or beside the basket. Where the scooter cannot park for them,
+    someone picks them up; left there, a mug that missed the basket at a table kept the user
+    from parking at that table for its other two objects."""
+    areas = [s for s in scene.surfaces if s.kind == "floor"]
+    out = []
+    for name in referee.instances():
+        if referee.taken_out(name):
+            continue
+        world = referee.object_points(name, frame="world")
+        if len(world) == 0 or world[:, 2].min() > FLOOR_LYING:
+            continue
+        xy = world[:, :2].mean(axis=0)
+        if not any(_within(area, xy) for area in areas):
+            out.append(name)
+    return out
+
+
+def _within(surface: Surface, xy: np.ndarray) -> bool:
+    """Whether world (x, y) (m) lies over the surface's footprint."""
+    x0, x1, y0, y1 = surface.area()
+    lx, ly = surface.to_local(xy)
+    return bool(x0 <= lx <= x1 and y0 <= ly <= y1)

@@ -22,7 +22,11 @@ from laserpick.robot.sim.scenes import Scene, load_scene
 from laserpick.transforms import invert, matrix_from_quat, planar_pose
 from laserpick.types import DepthFrame, FusedCloud
 
-__all__ = ["Captured", "SimTruth", "capture", "inside_basket", "on_scooter"]
+__all__ = ["OUT_OF_PLAY", "Captured", "SimTruth", "capture", "inside_basket", "on_scooter"]
+
+#: Where (world x, y, m) `take_out` puts an object out of the scene: on the floor, out of
+#: the way.
+OUT_OF_PLAY = np.array([-5.0, 0.0])
 
 
 @dataclass
@@ -78,11 +82,15 @@ class SimTruth:
 
         def move(m: mujoco.MjModel, d: mujoco.MjData) -> None:
             j = m.joint(f"obj/{instance}")
-            d.qpos[j.qposadr[0] : j.qposadr[0] + 3] = [-5.0, 0.0, 0.5]
+            d.qpos[j.qposadr[0] : j.qposadr[0] + 3] = [*OUT_OF_PLAY, 0.5]
             d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
 
         self.robot.sim.call(move)
         self.robot.sleep(0.1)  # headless, the call lands at the next step: take it now
+
+    def taken_out(self, instance: str) -> bool:
+        """Whether `take_out` put the object out of the scene."""
+        return bool(np.linalg.norm(self.world_position(instance)[:2] - OUT_OF_PLAY) < 1.0)
 
     def dot_on(self, instance: str) -> bool:
         """Whether the aiming beam's dot lies on `instance` now: what the user sees."""
