@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from laserpick.bench.parking import fallen, go_to_object, obstacles, parking_pose
 from laserpick.bench.picking import (
     BENCH,
     LEVER_MAX,
@@ -22,6 +23,7 @@ from laserpick.bench.protocols.jeeves import JEEVES_MODELS, jeeves_scene
 from laserpick.bench.protocols.laser_scan import scan_points
 from laserpick.bench.protocols.pick_place import coin_flip_kitchen
 from laserpick.bench.referee import Referee
+from laserpick.bench.route_planning import parked_clear
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.robot.sim.scenes import load_scene, scene_config
@@ -208,5 +210,30 @@ def test_a_tasks_random_draws_do_not_depend_on_the_tasks_before_it() -> None:
         other = draws()
         for a, b in zip(first, other, strict=True):
             assert not np.array_equal(a, b)
+    finally:
+        session.close()
+
+
+def test_where_something_fallen_keeps_the_user_from_parking_it_is_picked_up() -> None:
+    """The mug lies on the floor where the scooter parks before the 73 cm table, as one that
+    missed the basket there does: the user cannot park there for the table's soda can until
+    someone picks the mug up, and then does. What lies on a floor area was put there, and
+    stays."""
+    scene = load_scene("kitchen", seed=1)
+    session = open_session(scene, seed=5)
+    try:
+        op = ScriptedOperator(session, np.random.default_rng(5), seed=5)
+        table = scene.surface("table_73")
+        local_y = table.to_local(op.referee.world_position("soda_can")[:2])[1]
+        goal = parking_pose(table, local_y)  # where the user parks for the soda can
+        spot = planar_pose(*goal) @ np.array([0.6, -0.2, 0.0, 1.0])  # under the scooter
+        op.referee.put_back("mug", np.array([spot[0], spot[1], 0.0, 1.0, 0.0, 0.0, 0.0]))
+        assert fallen(scene, op.referee) == ["mug"]
+        on_floor = obstacles(scene.surfaces, op.referee, ["mug"])
+        assert not parked_clear(goal, on_floor, op.referee.outline())
+        assert go_to_object(op, scene, "soda_can")
+        assert op.referee.taken_out("mug")
+        assert np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.05
+        assert not any(op.referee.taken_out(n) for n in ("stuffed_toy", "tissue_packet"))
     finally:
         session.close()
