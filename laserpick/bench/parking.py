@@ -142,7 +142,8 @@ def park(
     or the object on a floor it picks (None: a free spot on a floor). A floor may be driven
     onto from any side: the user tries each of FLOOR_TURNS, the spot straight before the arm
     and then a little to a side (FLOOR_ACROSS), until one parks clear of everything else and
-    leads there."""
+    leads there. Where none does and something that fell lies on the floor (`fallen`), the
+    user asks for it to be picked up and tries once more."""
     floor = surface.kind == "floor"
     ways = itertools.product(FLOOR_ACROSS, FLOOR_TURNS) if floor else [(0.0, 0.0)]
     ways = [(across + a, turn) for a, turn in ways]
