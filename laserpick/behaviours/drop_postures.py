@@ -9,12 +9,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from laserpick.behaviours.laid_in import DOWN, laid_in_candidates, scooter_only
+from laserpick.behaviours.laid_in import hand_turns, laid_in_candidates, scooter_only
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, held_at
 from laserpick.settings import BehaviourSettings, MotionSettings, get_settings
-from laserpick.transforms import roty, rotz
 
 __all__ = [
     "basket_opening",
@@ -68,25 +67,15 @@ def _drop_candidates(tilted: bool, heights: tuple[float, ...]) -> tuple[np.ndarr
     free = scooter_only()
     if tilted:
         offsets = np.linspace(-0.2, 0.2, 5)
-        grid = itertools.product(
-            offsets,
-            offsets,
-            heights,
-            np.radians(np.arange(0, 360, 30)),
-            np.radians((45, 60, 75, 90)),
-        )
+        turns = hand_turns(np.arange(0, 360, 30), (45, 60, 75, 90))
+        grid = itertools.product(offsets, offsets, heights, turns)
     else:
-        grid = itertools.product(
-            np.linspace(-0.3, 0.3, 3) * inner[0],
-            np.linspace(-0.3, 0.3, 3) * inner[1],
-            heights,
-            np.radians(np.arange(0, 180, 30)),
-            np.radians((0, 15, 30)),
-        )
+        dxs, dys = (np.linspace(-0.3, 0.3, 3) * inner[i] for i in range(2))
+        grid = itertools.product(dxs, dys, heights, hand_turns(np.arange(0, 180, 30), (0, 15, 30)))
     out = []
-    for dx, dy, dz, yaw, tilt in grid:
+    for dx, dy, dz, R in grid:
         T = np.eye(4)
-        T[:3, :3] = rotz(yaw) @ roty(tilt) @ DOWN
+        T[:3, :3] = R
         T[:3, 3] = [centre[0] + dx, centre[1] + dy, rim + dz]
         Q = ik_tcp(T, dims.UR5_READY_Q)
         out += [q for q, ok in zip(Q, free.clearance_ok(Q), strict=True) if ok]

@@ -16,7 +16,7 @@ from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import PAYLOAD_POINT_RADIUS, CollisionChecker
 from laserpick.transforms import roty, rotz
 
-__all__ = ["hand_down_turns", "laid_in_candidates", "scooter_only", "squared_turns"]
+__all__ = ["hand_down_turns", "hand_turns", "laid_in_candidates", "scooter_only", "squared_turns"]
 
 #: The hand pointing down: the TCP's approach axis along -z of `base`.
 DOWN = np.diag([1.0, -1.0, -1.0])
@@ -29,11 +29,17 @@ def scooter_only(margin: float = 0.01) -> CollisionChecker:
     return CollisionChecker(np.zeros((0, 3)), margin=margin)
 
 
+def hand_turns(yaws: Sequence[float], tilts: Sequence[float]) -> list[np.ndarray]:
+    """Hand orientations (3, 3; TCP to `base`): pointing down, tilted up by each of `tilts`
+    (deg) and turned about the vertical by each of `yaws` (deg); yaw-major order."""
+    turns = itertools.product(np.radians(yaws), np.radians(tilts))
+    return [rotz(yaw) @ roty(tilt) @ DOWN for yaw, tilt in turns]
+
+
 def hand_down_turns() -> list[np.ndarray]:
     """Hand orientations (3, 3; TCP to `base`): pointing down or tilted up to 30 deg, turned
     any way about the vertical in 30 deg steps."""
-    turns = itertools.product(np.radians(np.arange(0, 360, 30)), np.radians((0, 15, 30)))
-    return [rotz(yaw) @ roty(tilt) @ DOWN for yaw, tilt in turns]
+    return hand_turns(np.arange(0, 360, 30), (0, 15, 30))
 
 
 def squared_turns(held: np.ndarray) -> list[np.ndarray]:
