@@ -23,6 +23,7 @@ from arm_setups import (
 from basket import assert_in_basket
 
 from laserpick.behaviours import (
+    CARRY_PLANNING,
     NO_BASKET_HOLD,
     Behaviours,
     basket_opening,
@@ -85,6 +86,8 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     dropped = b.drop_in_basket()
     assert dropped.ok, dropped.failure
     assert dropped.caution is None, "let go wholly over the opening"
+    # The postures and the path were planned while the arm held still, and that is said.
+    assert dropped.timings[CARRY_PLANNING] > 0
     robot.sleep(1.0)
     assert referee.in_basket(name)
     assert not robot.gripper_state().closed

@@ -11,6 +11,7 @@ import pytest
 from arm_setups import BEHAVIOUR, SETTINGS, TABLE_TOP, isolation_robot, pick_object, side_pose
 
 from laserpick.behaviours import (
+    CARRY_PLANNING,
     MARK_MOVES,
     Behaviours,
     Held,
@@ -132,7 +133,8 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     up0 = matrix_from_quat(referee.world_quat(name)).T @ [0.0, 0.0, 1.0]
     # Held out of the cameras' view while the user marks, as the session does: held where
     # it was lifted, the hand can hide the spot.
-    assert b.tuck().ok
+    tucked = b.tuck()
+    assert tucked.ok and tucked.timings[CARRY_PLANNING] > 0
     # A free spot on the table, to the right of everything: the user's place mark.
     mark = np.array([1.45, -0.55, TABLE_TOP])
     frames = robot.capture()
@@ -144,6 +146,7 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     out = b.place(cloud, mark)
     stop_recording()
     assert out.ok, out.failure
+    assert out.timings[CARRY_PLANNING] > 0  # the place poses and the path there
     # The carry there and the stow after went around a wall under the table's front
     # (`surface_front`), at the nearest of its top the cameras saw, down to the floor,
     # where they saw little of the table: what the hand holds may hang below it.

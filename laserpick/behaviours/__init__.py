@@ -33,7 +33,7 @@ from laserpick.behaviours.messages import (
     PAST_THE_OPENING,
     crowded_message,
 )
-from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.outcome import CARRY_PLANNING, Outcome
 from laserpick.behaviours.pick import Picking
 from laserpick.behaviours.place import Placing
 from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses, turned_hand_xy
@@ -42,6 +42,7 @@ from laserpick.behaviours.stow import Stowing
 from laserpick.behaviours.withdraw import Withdrawing
 
 __all__ = [
+    "CARRY_PLANNING",
     "GRIPPER_TIME",
     "MARK_MOVES",
     "NOT_HOLDING",

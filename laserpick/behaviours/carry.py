@@ -9,7 +9,7 @@ import numpy as np
 
 from laserpick.behaviours.guarded_motion import GuardedMotion
 from laserpick.behaviours.messages import NOT_HOLDING
-from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried
@@ -130,7 +130,8 @@ class Carrying(GuardedMotion):
         the user drives and marks where it goes: out of the cameras' view, the laser's way and
         the furniture's (raised in front, the object hangs 1.6 m ahead of the rear axle, into
         a shelf the scooter parks at). Where `tuck_searches` searches find no way there,
-        raised in front (the high ready pose)."""
+        raised in front (the high ready pose). The outcome's timings give the searches'
+        wall-clock seconds (`CARRY_PLANNING`)."""
         held = self.held
         if held is None:
             return Outcome(Failure("precondition", NOT_HOLDING))
@@ -140,10 +141,13 @@ class Carrying(GuardedMotion):
         b = self.settings.behaviour
         high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
         carry = holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp, b.hold_turns)
+        searched = 0.0
         for _ in range(b.tuck_searches):
             out = self.go_to(
                 carry, held.surroundings, "tucking it in", via=(high,), payload=held.points_tcp
             )
+            searched += out.timings[SEARCH]
             if out.ok or out.failure is None or out.failure.kind != "ik_plan":
-                return out  # it went there, or a motion was stopped: no second one
-        return self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
+                return out.planned_for(searched)  # there, or stopped: no second search
+        out = self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
+        return out.planned_for(searched + out.timings[SEARCH])

@@ -8,6 +8,7 @@ controller message."""
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from laserpick.behaviours.hand import GRIPPER_TIME
 from laserpick.behaviours.held import Held, WayIn
-from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import joint_path, timed
@@ -132,8 +133,10 @@ class GuardedMotion:
         """A collision-free joint move to q_goal (6,) rad; when no path is found, through
         each configuration of `via` in turn (two shorter searches instead of one long).
         kw: passed to `joint_path` (`payload`, TCP frame: what the hand carries, which also
-        slows the move to the carrying speed, `joint_speed_for`)."""
+        slows the move to the carrying speed, `joint_speed_for`). The outcome's timings
+        give the wall-clock seconds the search took (`SEARCH`)."""
         s, q = self.settings.motion, self.current_q()
+        t0 = time.perf_counter()
         path = joint_path(q, q_goal, checker, self.rng, s, **kw)
         for q_via in via:
             if path is not None:
@@ -143,14 +146,18 @@ class GuardedMotion:
                 joint_path(q_via, q_goal, checker, self.rng, s, **kw) if first is not None else None
             )
             path = None if second is None else np.vstack([first, second[1:]])
+        searched = {SEARCH: time.perf_counter() - t0}
         if path is None:
-            return Outcome(Failure("ik_plan", f"No collision-free path was found for {what}."))
+            msg = f"No collision-free path was found for {what}."
+            return Outcome(Failure("ik_plan", msg), timings=searched)
         speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
 
         def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
             return checker.clearance_ok(Q, **kw)
 
-        return Outcome(self.run(timed(path, s, joint_speed=speed, clear=clear), what))
+        return Outcome(
+            self.run(timed(path, s, joint_speed=speed, clear=clear), what), timings=searched
+        )
 
     def descend(
         self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0

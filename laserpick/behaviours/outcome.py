@@ -8,7 +8,13 @@ import numpy as np
 
 from laserpick.types import Failure, Grasp
 
-__all__ = ["Outcome"]
+__all__ = ["CARRY_PLANNING", "SEARCH", "Outcome"]
+
+#: `Outcome.timings` keys: wall-clock seconds spent searching a joint path (`go_to`), and
+#: spent planning the way of what the hand holds (its postures and paths), during which the
+#: arm stands still with the object in the hand.
+SEARCH = "search"
+CARRY_PLANNING = "plan_carry"
 
 
 @dataclass(frozen=True)
@@ -33,6 +39,10 @@ class Outcome:
     @property
     def ok(self) -> bool:
         return self.failure is None
+
+    def planned_for(self, seconds: float) -> Outcome:
+        """This outcome with `seconds` (wall clock) of carry planning as its only timing."""
+        return replace(self, timings={CARRY_PLANNING: seconds})
 
     def cautioned(self, caution: str | None) -> Outcome:
         """This outcome with `caution` said: as its caution when it is done, after its

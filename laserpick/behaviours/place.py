@@ -4,6 +4,8 @@ place mark, lower it until the surface is felt, let go, leave it, and stow aroun
 from __future__ import annotations
 
 import logging
+import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -11,7 +13,7 @@ from laserpick.behaviours.carry import Carrying, holding_pose
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import NOT_HOLDING
-from laserpick.behaviours.outcome import Outcome
+from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses
 from laserpick.behaviours.stow import Stowing
 from laserpick.description import dims
@@ -41,7 +43,8 @@ class Placing(Carrying, Leaving, Stowing):
         approach where that way is clear, else straight up), and the arm stows around the
         object where it now stands. Felt more than `place_above` early, it is something on
         the surface: the hand keeps the object and rises. Nothing felt by `place_below`
-        under the rest: the hand keeps it.
+        under the rest: the hand keeps it. The outcome's timings give the carry's planning
+        (`CARRY_PLANNING`: the place poses and the path, wall-clock s).
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -52,38 +55,43 @@ class Placing(Carrying, Leaving, Stowing):
         if isinstance(spot, Failure):
             return Outcome(Failure("precondition", f"I can't place there: {spot.message}."))
         q_now = self.current_q()
+        t0 = time.perf_counter()
         obstacles = cloud.points[not_carried(cloud.points, held.at(tcp_pose(q_now)))]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
         poses = place_poses(held, spot, checker, self.settings)
+        planning = time.perf_counter() - t0
         if isinstance(poses, Failure):
-            return Outcome(poses)
+            return Outcome(poses).planned_for(planning)
         self.progress("Carrying the object to the place mark.")
         out = self._carry_over_spot(poses.q_above, checker, spot, held)
+        planned = out.planned_for(planning + out.timings[SEARCH]).timings
         if not out.ok:
-            return out
+            return replace(out, timings=planned)
         lost = self.dropped_on_the_way("the place")
         if lost is not None:
-            return lost
+            return replace(lost, timings=planned)
         failure = self._lower_and_let_go(poses)
         if failure is not None:
-            return Outcome(failure)
+            return Outcome(failure, timings=planned)
         T_release = tcp_pose(self.current_q())
         failure = self.leave_object(poses.T_above, checker)
         if failure is not None:
-            return Outcome(failure, held.grasp, spot=spot)
-        return self._stow_around_placed(held, T_release, checker, spot)
+            return Outcome(failure, held.grasp, spot=spot, timings=planned)
+        placed = self._stow_around_placed(held, T_release, checker, spot)
+        return replace(placed, timings=planned)
 
     def _carry_over_spot(
         self, q_above: np.ndarray, checker: CollisionChecker, spot: np.ndarray, held: Held
     ) -> Outcome:
         """Carry what the hand holds to q_above (6,) rad, over the place `spot` (m, `base`),
         around `checker`, first also around a wall under the spot's surface's seen front
-        (`surface_front`), then without it. An object that hangs below the hand, carried up
+        (`surface_front`), then without it; its timings give the searches' seconds
+        (`SEARCH`). An object that hangs below the hand, carried up
         to a counter around what the cameras saw, is swept through the counter's unseen
         front, and turns in the pads."""
         front = front_wall(checker.points, float(spot[2]))
         tries = [checker.with_points(front), checker] if len(front) else [checker]  # floor: none
-        turns = self.settings.behaviour.hold_turns
+        turns, searched = self.settings.behaviour.hold_turns, 0.0
         for around in tries:
             out = self.go_to(
                 q_above,
@@ -92,9 +100,10 @@ class Placing(Carrying, Leaving, Stowing):
                 via=(holding_pose(dims.UR5_HIGH_READY_Q, around, held.points_tcp, turns),),
                 payload=held.points_tcp,
             )
+            searched += out.timings[SEARCH]
             if out.failure is None or out.failure.kind != "ik_plan":
                 break
-        return out
+        return replace(out, timings={SEARCH: searched})
 
     def _lower_and_let_go(self, poses: PlacePoses) -> Failure | None:
         """Lower the object along `poses.down` until the surface is felt, ease off it and

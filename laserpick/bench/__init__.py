@@ -39,8 +39,10 @@ FAILURE_KINDS = (
     "execute",
 )
 #: The stages timed per attempt (s). All but execute_sim are wall-clock time of the pipeline;
-#: execute_sim is simulated time from "go" until the hand lets go of the object (in the basket
-#: or at the place mark); attempt_total is their sum.
+#: plan_carry is the planning done while the hand holds the object (its postures and paths to
+#: the basket, the tuck and the place), the arm standing still meanwhile; execute_sim is
+#: simulated time from "go" until the hand lets go of the object (in the basket or at the
+#: place mark); attempt_total is their sum.
 STAGES = (
     "acquire_cloud",
     "detect_laser",
@@ -49,6 +51,7 @@ STAGES = (
     "filter",
     "select",
     "plan",
+    "plan_carry",
     "execute_sim",
     "attempt_total",
 )

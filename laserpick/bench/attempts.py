@@ -73,6 +73,7 @@ def stage_timings(jobs: list[dict[str, Any]], execute_sim: float | None = None) 
         "filter": raw.get("filter"),
         "select": raw.get("select"),
         "plan": raw.get("plan"),
+        "plan_carry": raw.get("plan_carry"),
         "execute_sim": execute_sim,
     }
     timings = {k: float(v) for k, v in out.items() if v is not None}

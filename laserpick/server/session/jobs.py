@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 
+from laserpick.behaviours import CARRY_PLANNING, Outcome
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasp_choice import find_grasps
@@ -127,6 +128,7 @@ class Jobs(Retreat, Foresight):
             self._drop_job()
             return
         tucked = self.behaviours.tuck()
+        self._count_carry_planning(tucked)
         if not tucked.ok:
             assert tucked.failure is not None
             self._retreat(tucked.failure, tucked=tucked)
@@ -138,15 +140,18 @@ class Jobs(Retreat, Foresight):
         self._retake_held_surroundings()
         b = self.behaviours
         out = b.drop_in_basket()
+        self._count_carry_planning(out)
         if out.failure is not None and out.failure.kind == "ik_plan" and b.held is not None:
             # No way to the basket from where the lift left the object (in a narrow gap, say):
             # it is tucked in and carried from there.
             self._progress("Tucking the object in on the way to the basket.")
             tucked = b.tuck()
+            self._count_carry_planning(tucked)
             if not tucked.ok:
                 self._retreat(out.failure, tucked=tucked)
                 return
             out = b.drop_in_basket()
+            self._count_carry_planning(out)
         if not out.ok:
             assert out.failure is not None
             self._retreat(out.failure)
@@ -171,8 +176,15 @@ class Jobs(Retreat, Foresight):
         self._projection = highlight_disc(self.projector, mark.point)
         self._progress("Placing.")
         out = self.behaviours.place(cloud, mark.point)
+        self._count_carry_planning(out)
         if not out.ok:
             assert out.failure is not None
             self._retreat(out.failure)
             return
         self.stow_and_rest("Placed.", placed=out)
+
+    def _count_carry_planning(self, out: Outcome) -> None:
+        """Add what `out` spent planning the way of what the hand holds (`CARRY_PLANNING`,
+        wall-clock s, the arm standing still meanwhile) to the task's timings."""
+        spent = out.timings.get(CARRY_PLANNING, 0.0)
+        self.task.timings[CARRY_PLANNING] = self.task.timings.get(CARRY_PLANNING, 0.0) + spent
