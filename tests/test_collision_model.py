@@ -9,6 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 from arm_poses import EMPTY, top_grasp
+from arm_setups import box_points
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
@@ -24,7 +25,14 @@ from laserpick.pipeline.collision import (
     surface_front,
     thin,
 )
-from laserpick.pipeline.collision.keepout import box_gaps
+from laserpick.pipeline.collision.arm_spheres import HAND_BODY
+from laserpick.pipeline.collision.carried import (
+    PAYLOAD_CLEAR_OF_BODY,
+    PAYLOAD_POINT_RADIUS,
+    held_points,
+    off_upper_links,
+)
+from laserpick.pipeline.collision.keepout import BOX_CHECKS, box_contacts, box_gaps
 from laserpick.robot.sim.model import ModelInfo, build_sim_model
 
 
@@ -306,3 +314,31 @@ def test_segment_check_finds_an_obstacle_between_its_coarse_samples():
 def test_checker_ignores_non_finite_points(bad):
     pts = np.array([[1.5, -0.3, bad], [5.0, 5.0, 5.0]])
     assert len(CollisionChecker(pts).points) == 0
+
+
+def test_the_broad_phases_change_no_verdict():
+    """The keep-out boxes and the upper links are first tested against a ball about each
+    body's spheres (and the held object's points): the verdicts are those of measuring
+    every sphere and every point, at configurations all over the joint space, some touching
+    and some clear, at no margin, the usual one and a wider one."""
+    rng = np.random.default_rng(7)
+    Q = rng.uniform(
+        np.maximum(dims.UR5_Q_MIN, -math.pi), np.minimum(dims.UR5_Q_MAX, math.pi), (3000, 6)
+    )
+    payload = box_points((0.19, 0.06, 0.24), step=0.03)  # a cereal box held at its top
+    frames = body_frames(Q)
+    held = held_points(frames, payload)
+    centres = np.concatenate([sphere_centres(frames), held], axis=1)
+    radius = np.append(SPHERES.radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
+    body = np.append(SPHERES.body, np.full(len(payload), HAND_BODY))
+    upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
+    links = sphere_centres(frames)[:, upper]
+    for margin in (0.0, 0.01, 0.03):
+        reach = radius + margin
+        every = (box_gaps(centres) < reach[:, None]) & BOX_CHECKS[body]
+        assert 0 < every.any(axis=(1, 2)).sum() < len(Q)
+        assert np.array_equal(box_contacts(centres, reach, body), every)
+        gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
+        apart = ~(gap < SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin).any(axis=(1, 2))
+        assert 0 < apart.sum() < len(Q)
+        assert np.array_equal(off_upper_links(frames, held, margin), apart)

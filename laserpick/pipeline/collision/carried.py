@@ -13,6 +13,7 @@ from laserpick.description.kinematics import T_FLANGE_TCP
 from laserpick.description.shapes import body_frames
 from laserpick.pipeline.cloud import thin
 from laserpick.pipeline.collision.arm_spheres import SPHERES, sphere_centres
+from laserpick.pipeline.collision.broad_phase import BROAD_SLACK
 
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
 PAYLOAD_POINT_RADIUS = 0.01
@@ -48,12 +49,20 @@ def held_clear_of_arm(Q: np.ndarray, payload: np.ndarray, margin: float) -> np.n
 
 def off_upper_links(frames: np.ndarray, held: np.ndarray, margin: float) -> np.ndarray:
     """`held_clear_of_arm` for body frames (B, 7, 4, 4) and the held points where they are
-    (B, P, 3; m, `base`, `held_points`)."""
+    (B, P, 3; m, `base`, `held_points`). Point by point only against the link spheres that
+    the ball about the points' mean, holding them all, comes within reach of: the held
+    object is mostly far from the upper arm, and its points are many."""
     upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
     links = sphere_centres(frames)[:, upper]
-    gap = np.linalg.norm(held[:, :, None] - links[:, None], axis=-1)
     reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
-    return ~(gap < reach).any(axis=(1, 2))
+    middle = held.mean(axis=1, keepdims=True)
+    spread = np.linalg.norm(held - middle, axis=-1).max(axis=1)
+    apart = np.linalg.norm(links - middle, axis=-1)
+    rows, near = np.nonzero(apart < spread[:, None] + reach + BROAD_SLACK)
+    gap = np.linalg.norm(held[rows] - links[rows, near][:, None], axis=-1)
+    clear = np.ones(len(held), bool)
+    clear[rows[(gap < reach[near][:, None]).any(axis=1)]] = False
+    return clear
 
 
 def mirrored_back(

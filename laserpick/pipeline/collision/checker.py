@@ -15,12 +15,13 @@ from scipy.spatial import cKDTree
 
 from laserpick.description.shapes import FLOOR_CLEARANCE, KEEPOUT_BOXES, body_frames
 from laserpick.pipeline.collision.arm_spheres import HAND_BODY, SPHERES, sphere_centres
+from laserpick.pipeline.collision.broad_phase import Ball, balls
 from laserpick.pipeline.collision.carried import (
     PAYLOAD_POINT_RADIUS,
     held_points,
     off_upper_links,
 )
-from laserpick.pipeline.collision.keepout import BOX_CHECKS, box_gaps
+from laserpick.pipeline.collision.keepout import box_contacts
 from laserpick.pipeline.collision.obstacles import obstacle_mask
 from laserpick.pipeline.collision.seen_space import OWN_SPACE_PADDING, OwnSpace, unseen_spheres
 from laserpick.types import DepthFrame
@@ -212,19 +213,35 @@ class CollisionChecker:
         """For spheres (B, S) of `radius` (S,) on the arm's `body` (S,): whether each is
         below the floor's clearance (B, S), within `margin` of each keep-out box that checks
         its body (B, S, K), and of the cloud (B, S)."""
-        B, S, _ = centres.shape
-        reach = radius[None, :] + margin
+        reach = radius + margin
         # A negative margin (the hand at its grasp may touch the support) holds for the
         # floor too: for an object on the floor, the floor is the support.
         clearance = self.floor_clearance if margin >= 0 else margin
         floor = centres[..., 2] < radius + clearance
-        boxes = (box_gaps(centres) < reach[..., None]) & BOX_CHECKS[body]
-        cloud = np.zeros((B, S), bool)
-        if self.tree is not None:
-            bound = float(radius.max() + margin)
-            d, _ = self.tree.query(centres.reshape(-1, 3), k=1, distance_upper_bound=bound)
-            cloud = d.reshape(B, S) < reach
-        return floor, boxes, cloud
+        few, bounded = balls(centres, reach, body)
+        boxes = box_contacts(centres, reach, body, (few, bounded))
+        return floor, boxes, self._near_cloud(centres, reach, few, bounded)
+
+    def _near_cloud(
+        self, centres: np.ndarray, reach: np.ndarray, few: np.ndarray, bounded: list[Ball]
+    ) -> np.ndarray:
+        """(B, S) whether each sphere, at centres (B, S, 3) (m), comes within its `reach`
+        (S,) (m) of the cloud: the `few` one by one, the spheres of each `bounded` ball
+        only where the ball comes within reach of a point (`broad_phase.balls`)."""
+        near = np.zeros(centres.shape[:2], bool)
+        if self.tree is None:
+            return near
+        parts = [(np.arange(len(centres)), few)]
+        for ball in bounded:
+            d, _ = self.tree.query(ball.middle, k=1, distance_upper_bound=float(ball.radius.max()))
+            parts.append((np.flatnonzero(d < ball.radius), ball.spheres))
+        bound = float(reach.max())
+        for rows, spheres in parts:
+            if len(rows) and len(spheres):
+                at = centres[rows[:, None], spheres[None, :]]
+                d, _ = self.tree.query(at.reshape(-1, 3), k=1, distance_upper_bound=bound)
+                near[rows[:, None], spheres[None, :]] = d.reshape(at.shape[:2]) < reach[spheres]
+        return near
 
     def _hits(
         self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float
