@@ -231,11 +231,14 @@ class CollisionChecker:
         near = np.zeros(centres.shape[:2], bool)
         if self.tree is None:
             return near
+        bound = float(reach.max())
+        if not bounded:  # every sphere one by one, as they come
+            d, _ = self.tree.query(centres.reshape(-1, 3), k=1, distance_upper_bound=bound)
+            return d.reshape(near.shape) < reach
         parts = [(np.arange(len(centres)), few)]
         for ball in bounded:
             d, _ = self.tree.query(ball.middle, k=1, distance_upper_bound=float(ball.radius.max()))
             parts.append((np.flatnonzero(d < ball.radius), ball.spheres))
-        bound = float(reach.max())
         for rows, spheres in parts:
             if len(rows) and len(spheres):
                 at = centres[rows[:, None], spheres[None, :]]

@@ -51,8 +51,10 @@ def box_contacts(
     (B, S, 3) (m, `base`): the verdicts of comparing `box_gaps` of every centre, the many
     spheres of one body measured only against the boxes their ball comes near
     (`broad_phase.balls`, or `grouped`, what it gave for these spheres)."""
-    out = np.zeros((*centres.shape[:2], len(KEEPOUT_BOXES)), bool)
     few, bounded = grouped if grouped is not None else balls(centres, reach, body)
+    if not bounded:  # every sphere one by one, as they come
+        return (box_gaps(centres) < reach[:, None]) & BOX_CHECKS[body]
+    out = np.zeros((*centres.shape[:2], len(KEEPOUT_BOXES)), bool)
     if len(few):
         near = box_gaps(centres[:, few]) < reach[few, None]
         out[:, few] = near & BOX_CHECKS[body[few]]
