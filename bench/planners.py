@@ -13,7 +13,9 @@ the joint-space path length (rad, summed Euclidean norm of the steps; median and
 the problems both solved) and its largest-joint sweep (what bounds its time at the joint
 speed limit), the configurations the search asked the collision checker
 about (mean: its work, which the machine's load does not change), and checks every returned
-path again at the checker's resolution (`CollisionChecker.segment_ok`).
+path again at the checker's resolution (`CollisionChecker.segment_ok`). Last, the CPU time
+of all the searches: on a shared machine, the way to compare two versions of the code run
+one after the other (the same configurations checked say they searched alike).
 
     LASERPICK_RECORD_PLANS=/tmp/plans/in-situ .venv/bin/laserpick bench --protocol in-situ \
         --seed 2 --trials 1 --out /tmp/in-situ.json
@@ -89,7 +91,8 @@ def counting(checker: CollisionChecker) -> list[int]:
 
 def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str, list]:
     """Each planner on each problem and seed: rows (problem, seed, found, seconds, length,
-    sweep, clear, configurations checked), planners taking turns on each problem."""
+    sweep, clear, configurations checked, CPU seconds), planners taking turns on each
+    problem."""
     s = get_settings().motion
     rows: dict[str, list] = {name: [] for name in planners}
     for k, f in enumerate(files):
@@ -97,16 +100,16 @@ def run(files: list[Path], planners: dict[str, Planner], seeds: int) -> dict[str
         checked = counting(checker)
         for seed, (name, plan) in itertools.product(range(seeds), planners.items()):
             checked[0] = 0
-            t = time.perf_counter()
+            t, cpu = time.perf_counter(), time.process_time()
             path = plan(q0, q1, checker, np.random.default_rng(seed), s, kw)
-            dt = time.perf_counter() - t
+            dt, cpu = time.perf_counter() - t, time.process_time() - cpu
             n = checked[0]
             found = path is not None
             clear = found and all(
                 checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(path)
             )
             lengths = (length(path), sweep(path)) if found else (np.nan, np.nan)
-            rows[name].append((k, seed, found, dt, *lengths, clear, n))
+            rows[name].append((k, seed, found, dt, *lengths, clear, n, cpu))
         line = ", ".join(f"{n} {rows[n][-1][3]:.2f} s {rows[n][-1][7]} q" for n in planners)
         print(f"{f.name}: {line}", flush=True)
     return rows
@@ -118,9 +121,9 @@ def report(rows: dict[str, list]) -> None:
     print(
         "\n| planner | solved | time median (s) | mean (s) | p90 (s) | length median (rad) |"
         " mean (rad) | largest-joint sweep, mean (rad) | configurations checked, mean |"
-        " paths clear |"
+        " paths clear | CPU total (s) |"
     )
-    print("|" + " --- |" * 10)
+    print("|" + " --- |" * 11)
     for name, r in rows.items():
         found = np.array([x[2] for x in r])
         dt = np.array([x[3] for x in r])
@@ -131,7 +134,8 @@ def report(rows: dict[str, list]) -> None:
             f"| {name} | {found.sum()}/{len(r)} ({100 * found.mean():.0f}%) "
             f"| {np.median(dt):.3f} | {dt.mean():.3f} | {np.percentile(dt, 90):.3f} "
             f"| {np.median(lengths):.2f} | {lengths.mean():.2f} | {sweeps.mean():.2f} "
-            f"| {np.mean([x[7] for x in r]):.0f} | {clear}/{found.sum()} |"
+            f"| {np.mean([x[7] for x in r]):.0f} | {clear}/{found.sum()} "
+            f"| {sum(x[8] for x in r):.1f} |"
         )
     print(f"\nlengths over the {both.sum()} runs that every planner solved")
 
