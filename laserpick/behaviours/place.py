@@ -13,7 +13,7 @@ from laserpick.behaviours.carry import Carrying, holding_pose
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import NOT_HOLDING
-from laserpick.behaviours.outcome import SEARCH, Outcome
+from laserpick.behaviours.outcome import CARRY_PLANNING, SEARCH, Outcome
 from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses
 from laserpick.behaviours.stow import Stowing
 from laserpick.description import dims
@@ -64,7 +64,7 @@ class Placing(Carrying, Leaving, Stowing):
             return Outcome(poses).planned_for(planning)
         self.progress("Carrying the object to the place mark.")
         out = self._carry_over_spot(poses.q_above, checker, spot, held)
-        planned = out.planned_for(planning + out.timings[SEARCH]).timings
+        planned = {CARRY_PLANNING: planning + out.timings[SEARCH]}
         if not out.ok:
             return replace(out, timings=planned)
         lost = self.dropped_on_the_way("the place")
@@ -86,9 +86,9 @@ class Placing(Carrying, Leaving, Stowing):
         """Carry what the hand holds to q_above (6,) rad, over the place `spot` (m, `base`),
         around `checker`, first also around a wall under the spot's surface's seen front
         (`surface_front`), then without it; its timings give the searches' seconds
-        (`SEARCH`). An object that hangs below the hand, carried up
-        to a counter around what the cameras saw, is swept through the counter's unseen
-        front, and turns in the pads."""
+        (`SEARCH`). An object that hangs below the hand, carried up to a counter around what
+        the cameras saw, is swept through the counter's unseen front, and turns in the
+        pads."""
         front = front_wall(checker.points, float(spot[2]))
         tries = [checker.with_points(front), checker] if len(front) else [checker]  # floor: none
         turns, searched = self.settings.behaviour.hold_turns, 0.0

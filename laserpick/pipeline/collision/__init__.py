@@ -3,7 +3,8 @@ of spheres (`arm_spheres`), tested against the fused cloud (`obstacles`: a KD-tr
 voxel-thinned points), the keep-out boxes around the scooter and its rider (`keepout`), and
 the floor; on planned transits, also against the space no camera saw (`seen_space`). What
 the hand carries is checked with it (`carried`), its many points bounded by a ball first
-(`broad_phase`). `CollisionChecker` (`checker`) asks all of these. Frames: `base` (x forward, y left, z up), metres; joint angles in rad.
+(`broad_phase`). `CollisionChecker` (`checker`) asks all of these. Frames: `base` (x
+forward, y left, z up), metres; joint angles in rad.
 """
 
 from laserpick.pipeline.cloud import thin

@@ -18,7 +18,7 @@ _IS_TURNED = np.array([b.turn != IDENTITY for b in KEEPOUT_BOXES])
 _TURNED = np.flatnonzero(_IS_TURNED)
 _ALIGNED = np.setdiff1d(np.arange(len(KEEPOUT_BOXES)), _TURNED)
 #: (3, 3 * turned): one product takes a point into every turned box's axes at once.
-_INTO_TURNED = np.array([KEEPOUT_BOXES[k].turn for k in _TURNED]).transpose(1, 0, 2).reshape(3, -1)
+_INTO_TURNED = _TURNS[_TURNED].transpose(1, 0, 2).reshape(3, -1)
 #: (7, K): whether arm body b (0 = link1 ... 6 = the hand, and what it holds) is checked
 #: against keep-out box k.
 BOX_CHECKS = np.array([[b not in box.spares for box in KEEPOUT_BOXES] for b in range(7)])
