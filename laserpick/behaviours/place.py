@@ -13,7 +13,7 @@ from laserpick.behaviours.carry import Carrying, holding_pose
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import NOT_HOLDING
-from laserpick.behaviours.outcome import CARRY_PLANNING, SEARCH, Outcome
+from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.behaviours.place_poses import PlacePoses, front_wall, place_poses
 from laserpick.behaviours.stow import Stowing
 from laserpick.description import dims
@@ -64,21 +64,21 @@ class Placing(Carrying, Leaving, Stowing):
             return Outcome(poses).planned_for(planning)
         self.progress("Carrying the object to the place mark.")
         out = self._carry_over_spot(poses.q_above, checker, spot, held)
-        planned = {CARRY_PLANNING: planning + out.timings[SEARCH]}
+        planning += out.timings[SEARCH]
         if not out.ok:
-            return replace(out, timings=planned)
+            return out.planned_for(planning)
         lost = self.dropped_on_the_way("the place")
         if lost is not None:
-            return replace(lost, timings=planned)
+            return lost.planned_for(planning)
         failure = self._lower_and_let_go(poses)
         if failure is not None:
-            return Outcome(failure, timings=planned)
+            return Outcome(failure).planned_for(planning)
         T_release = tcp_pose(self.current_q())
         failure = self.leave_object(poses.T_above, checker)
         if failure is not None:
-            return Outcome(failure, held.grasp, spot=spot, timings=planned)
+            return Outcome(failure, held.grasp, spot=spot).planned_for(planning)
         placed = self._stow_around_placed(held, T_release, checker, spot)
-        return replace(placed, timings=planned)
+        return placed.planned_for(planning)
 
     def _carry_over_spot(
         self, q_above: np.ndarray, checker: CollisionChecker, spot: np.ndarray, held: Held
