@@ -166,3 +166,41 @@ def test_the_fingers_close_together_and_report_the_objects_width():
     assert s.gripper_width == pytest.approx(0.066, abs=0.002)
     pushed = np.linalg.norm(s.xpos[body][:2] - before)
     assert pushed < 0.002, f"closing pushed the can {pushed * 1000:.1f} mm"
+
+
+def _until_still(sim: Simulation, most: float = 2.0) -> float:
+    """Step `sim` until its gripper reports its fingers still; the seconds that took."""
+    waited = 0.0
+    while sim.snapshot().gripper_moving or waited == 0.0:
+        assert waited < most, f"the gripper still reports moving after {most} s"
+        sim.settle(0.02)
+        waited += 0.02
+    return waited
+
+
+def test_the_gripper_reports_still_at_full_grip_and_lets_go_at_once():
+    """As the 2F-85 reports its object status: closed on a 6.6 cm can, the fingers are still
+    once the grip is at its force limit, well before the full stroke's time; opened, the
+    squeeze is off at once and the fingers stand fully open in a fraction of that."""
+    sim, _, _, _ = _at_grasp("soda_can")
+    stroke_time = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED
+    sim.gripper(True)
+    closing = _until_still(sim)
+    grip = abs(float(sim.data.actuator_force[sim.info.gripper_ctrl]))
+    assert closing < 0.9 * stroke_time, f"closing took {closing:.2f} s"
+    assert grip >= 0.99 * dims.GRIPPER_FORCE_MAX, f"still at {grip:.1f} N"
+    assert sim.snapshot().holding
+    sim.gripper(False)
+    opening = _until_still(sim)
+    s = sim.snapshot()
+    assert opening < 0.5 * stroke_time, f"opening took {opening:.2f} s"
+    assert s.gripper_width >= dims.GRIPPER_STROKE - 0.0015
+    assert s.gripper_force == 0.0
+
+
+def test_the_empty_gripper_reports_still_only_once_shut():
+    sim = Simulation(None, realtime=False)
+    sim.gripper(True)
+    closing = _until_still(sim)
+    assert closing >= dims.GRIPPER_STROKE / dims.GRIPPER_SPEED - 0.02
+    assert sim.snapshot().gripper_width < dims.GRIPPER_EMPTY_GAP

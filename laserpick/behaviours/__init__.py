@@ -23,7 +23,7 @@ from laserpick.behaviours.drop_postures import (
     rank_drop_postures,
 )
 from laserpick.behaviours.guarded_motion import GuardedMotion
-from laserpick.behaviours.hand import GRIPPER_TIME
+from laserpick.behaviours.hand import wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import (
@@ -43,7 +43,6 @@ from laserpick.behaviours.withdraw import Withdrawing
 
 __all__ = [
     "CARRY_PLANNING",
-    "GRIPPER_TIME",
     "MARK_MOVES",
     "NOT_HOLDING",
     "NO_BASKET_HOLD",
@@ -74,6 +73,7 @@ __all__ = [
     "place_poses",
     "rank_drop_postures",
     "turned_hand_xy",
+    "wait_for_gripper",
     "without_leftovers",
 ]
 

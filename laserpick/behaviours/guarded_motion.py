@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from laserpick.behaviours.hand import GRIPPER_TIME
+from laserpick.behaviours.hand import wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.pipeline.collision import CollisionChecker
@@ -181,6 +181,6 @@ class GuardedMotion:
     def release(self) -> None:
         """Open the hand and give it the time to open: it holds nothing from here."""
         self.robot.gripper(False)
-        self.robot.sleep(GRIPPER_TIME)
+        wait_for_gripper(self.robot)
         self.held = None
         self.way_in = None

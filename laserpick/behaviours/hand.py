@@ -5,10 +5,31 @@ from __future__ import annotations
 from laserpick.description import dims
 from laserpick.robot.interface import Robot
 
-__all__ = ["GRIPPER_TIME", "closed_on_something", "pad_force", "peak_pad_force"]
+__all__ = [
+    "GRIPPER_TIME",
+    "closed_on_something",
+    "pad_force",
+    "peak_pad_force",
+    "wait_for_gripper",
+]
 
 #: Time (s) the gripper gets to close or open: the full 85 mm stroke at 0.15 m/s, plus margin.
 GRIPPER_TIME = dims.GRIPPER_STROKE / dims.GRIPPER_SPEED + 0.3
+#: How often (s) a wait reads the gripper's status: a 2F-85 reports at 50 Hz and more.
+GRIPPER_POLL = 0.02
+
+
+def wait_for_gripper(robot: Robot) -> float:
+    """Give the gripper the time to close or open (its last command): until it reports its
+    fingers still (`GripperState.moving`), and at most `GRIPPER_TIME`. Returns the robot
+    time (s) waited. A 6 cm object is held at the full grip force after some 0.5 s, and let
+    go of, fully open, after 0.2 s: the full stroke's time was waited before."""
+    waited = 0.0
+    while True:
+        robot.sleep(GRIPPER_POLL)
+        waited += GRIPPER_POLL
+        if not robot.gripper_state().moving or waited >= GRIPPER_TIME - 1e-9:
+            return waited
 
 
 def pad_force(robot: Robot) -> float:

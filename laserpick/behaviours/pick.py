@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 
 from laserpick.behaviours.carry import without_leftovers
 from laserpick.behaviours.drop_postures import holds_over_basket
-from laserpick.behaviours.hand import GRIPPER_TIME, closed_on_something
+from laserpick.behaviours.hand import closed_on_something, wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.messages import NO_BASKET_HOLD
 from laserpick.behaviours.outcome import Outcome
@@ -104,7 +104,7 @@ class Picking(Withdrawing):
             return failure
         self.progress("Closing the gripper.")
         self.robot.gripper(True)
-        self.robot.sleep(GRIPPER_TIME)
+        wait_for_gripper(self.robot)
         if not closed_on_something(self.robot):
             self._open_and_retreat(plan)
             return Failure("execute", "The gripper closed on nothing.")
@@ -153,7 +153,7 @@ class Picking(Withdrawing):
     def _open_and_retreat(self, plan: PickPlan) -> None:
         """After closing on nothing: open the hand and go back to the pre-grasp pose."""
         self.robot.gripper(False)
-        self.robot.sleep(GRIPPER_TIME)
+        wait_for_gripper(self.robot)
         back = cartesian_line(
             self.current_q(), tcp_pose(plan.approach.q[0]), self.settings.motion.cartesian_step
         )

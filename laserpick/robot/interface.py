@@ -81,12 +81,16 @@ class JointState:
 
 @dataclass(frozen=True)
 class GripperState:
-    """Opening between the pads (m), summed pad force (N), and the holding verdict."""
+    """Opening between the pads (m), summed pad force (N), the last command (closed), and
+    the holding verdict. moving: the fingers are still on their way, as the 2F-85 reports
+    it (gOBJ 0): closing, until shut or stopped on something at the grip force; opening,
+    until fully open. A gripper that reports no such status leaves it False."""
 
     width: float
     force: float
     closed: bool
     holding: bool
+    moving: bool = False
 
 
 @dataclass(frozen=True)

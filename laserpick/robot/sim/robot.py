@@ -95,7 +95,11 @@ class SimRobot:
     def gripper_state(self) -> GripperState:
         s = self.sim.snapshot()
         return GripperState(
-            width=s.gripper_width, force=s.gripper_force, closed=s.gripper_closed, holding=s.holding
+            width=s.gripper_width,
+            force=s.gripper_force,
+            closed=s.gripper_closed,
+            holding=s.holding,
+            moving=s.gripper_moving,
         )
 
     def base_pose(self) -> np.ndarray:
@@ -111,6 +115,7 @@ class SimRobot:
                 force=s.gripper_force,
                 closed=s.gripper_closed,
                 holding=s.holding,
+                moving=s.gripper_moving,
             ),
             base_pose=s.base_pose.copy(),
             base_velocity=s.base_velocity.copy(),

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from laserpick.behaviours import GRIPPER_TIME, Outcome
+from laserpick.behaviours import Outcome, wait_for_gripper
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
 from laserpick.pipeline.first_plan import at_rest
@@ -132,7 +132,7 @@ class Retreat(KeptViews):
         if b.held is None or not self.robot.gripper_state().holding:
             if self.robot.gripper_state().closed:
                 self.robot.gripper(False)
-                self.robot.sleep(GRIPPER_TIME)
+                wait_for_gripper(self.robot)
             b.held = None
             if not at_rest(self.robot.joint_state().q):  # a pick that found no way: stays
                 self._progress("Returning the arm.")

@@ -38,6 +38,7 @@ from laserpick.robot.sim.loop.contacts import (
     felt_force,
 )
 from laserpick.robot.sim.loop.drive import BaseDrive
+from laserpick.robot.sim.loop.gripper import GripperDrive
 from laserpick.robot.sim.loop.snapshot import Snapshot, take_snapshot
 from laserpick.robot.sim.model import ModelInfo, build_arm_model, build_sim_model
 from laserpick.robot.sim.scenes import Scene
@@ -72,6 +73,7 @@ class Simulation:
         self._arm_geoms[self.info.arm_geoms] = True
         self._pad_geoms = np.zeros(self.model.ngeom, bool)
         self._pad_geoms[self.info.pad_geoms] = True
+        self._grip = GripperDrive(kp=float(self.model.actuator_gainprm[self.info.gripper_ctrl, 0]))
         self.arm_model = build_arm_model()
         self._cartesian = CartesianController(self.arm_model)
         self.dt = float(self.model.opt.timestep)
@@ -105,10 +107,8 @@ class Simulation:
             d.qpos[info.finger_qpos] = dims.GRIPPER_STROKE / 2
             self._q_set = dims.UR5_HOME_Q.copy()
             d.ctrl[info.arm_ctrl] = self._q_set
-            self._grip_target = dims.GRIPPER_STROKE / 2
-            self._grip_set = self._grip_target
-            self._grip_closed = False
-            d.ctrl[info.gripper_ctrl] = self._grip_set
+            self._grip.reset()
+            d.ctrl[info.gripper_ctrl] = self._grip.setpoint
             self._motion: TrajectoryTracker | CartesianController | None = None
             self._handle: MotionHandle | None = None
             self._cartesian.target = None
@@ -200,8 +200,7 @@ class Simulation:
         def apply() -> None:
             if close and (self.estopped or self.deadman_tripped):
                 return
-            self._grip_closed = close
-            self._grip_target = 0.0 if close else dims.GRIPPER_STROKE / 2
+            self._grip.command(close, self._finger())
 
         self._post(apply)
 
@@ -383,8 +382,7 @@ class Simulation:
                 if isinstance(motion, TrajectoryTracker):
                     self._q_set = motion.setpoint(d.time)
                     for event in motion.due_events(d.time):
-                        self._grip_closed = event.action == "close"
-                        self._grip_target = 0.0 if self._grip_closed else dims.GRIPPER_STROKE / 2
+                        self._grip.command(event.action == "close", self._finger())
                     if self._stop_on_contact(motion.traj.guard_force):
                         return
                     if motion.finished(d.time):
@@ -405,10 +403,7 @@ class Simulation:
                 log.exception("arm control failed")
                 self._halt("failed", f"arm control failed: {exc}")
         d.ctrl[info.arm_ctrl] = self._q_set
-        # Gripper: ramp the finger setpoint at the gripper's speed.
-        step = dims.GRIPPER_SPEED / 2 * dt
-        self._grip_set += float(np.clip(self._grip_target - self._grip_set, -step, step))
-        d.ctrl[info.gripper_ctrl] = self._grip_set
+        d.ctrl[info.gripper_ctrl] = self._grip.tick(dt)
         self._drive.tick(dt, self._motion is None, self.arm_contacts)
 
     def _replace_motion(
@@ -463,12 +458,16 @@ class Simulation:
         """The contacts from outside on the arm, the gripper and what a closed gripper holds
         (`contacts.arm_contacts`)."""
         return arm_contacts(
-            self.model, self.data, self._arm_geoms, self._pad_geoms, self._grip_closed
+            self.model, self.data, self._arm_geoms, self._pad_geoms, self._grip.closed
         )
 
     def felt(self, contacts: list[Contact]) -> float:
         """What the UR5's force estimate reads of `contacts` (N; `contacts.felt_force`)."""
         return felt_force(self.model, contacts)
+
+    def _finger(self) -> float:
+        """Where the driven finger stands (m, its travel from the hand's centre)."""
+        return float(self.data.qpos[self.info.finger_qpos[0]])
 
     def _gripper_force(self) -> float:
         """Force (N) on the pads: what the gripper's own current sensing reports."""
@@ -479,7 +478,8 @@ class Simulation:
             self.data,
             self.info,
             gripper_force=self._gripper_force(),
-            gripper_closed=self._grip_closed,
+            gripper_closed=self._grip.closed,
+            gripper_moving=self._grip.moving(self._finger()),
             estopped=self.estopped,
             moving=self._handle is not None,
             drive_stop=self._drive.stop_reason,

@@ -31,6 +31,7 @@ class Snapshot:
     gripper_width: float  #: opening between the pads (m)
     gripper_force: float  #: summed normal force on the pads (N)
     gripper_closed: bool  #: the last gripper command was "close"
+    gripper_moving: bool  #: the fingers are still on their way (`GripperDrive.moving`)
     holding: bool
     estopped: bool
     moving: bool  #: an arm motion is in progress
@@ -47,6 +48,7 @@ def take_snapshot(
     *,
     gripper_force: float,
     gripper_closed: bool,
+    gripper_moving: bool,
     estopped: bool,
     moving: bool,
     drive_stop: str,
@@ -73,6 +75,7 @@ def take_snapshot(
         gripper_width=width,
         gripper_force=gripper_force,
         gripper_closed=gripper_closed,
+        gripper_moving=gripper_moving,
         holding=gripper_closed
         and width > dims.GRIPPER_EMPTY_GAP
         and gripper_force > dims.GRIPPER_HOLD_FORCE,
