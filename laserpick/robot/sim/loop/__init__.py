@@ -2,8 +2,8 @@
 headless by its caller; other threads send it commands and read its `Snapshot`s.
 
 Beside it: the contacts on the arm and the force it feels (the guard and protective stops),
-the scooter's drive with its stop when driving pushes the still arm into something, and the
-snapshot every chunk publishes.
+the scooter's drive with its stop when driving pushes the still arm into something, the
+gripper's drive and its status, and the snapshot every chunk publishes.
 """
 
 from laserpick.robot.sim.loop.contacts import (
@@ -15,6 +15,7 @@ from laserpick.robot.sim.loop.contacts import (
     felt_force,
 )
 from laserpick.robot.sim.loop.drive import DRIVE_STOP, DRIVE_STOP_CLEARS, BaseDrive
+from laserpick.robot.sim.loop.gripper import GripperDrive
 from laserpick.robot.sim.loop.simulation import Simulation
 from laserpick.robot.sim.loop.snapshot import Snapshot, take_snapshot
 
@@ -23,6 +24,7 @@ __all__ = [
     "DRIVE_STOP_CLEARS",
     "BaseDrive",
     "Contact",
+    "GripperDrive",
     "Simulation",
     "Snapshot",
     "arm_contacts",
