@@ -28,7 +28,7 @@ from laserpick.pipeline.plan import (
     transit_path,
 )
 from laserpick.pipeline.reach import pregrasp_pose, reachable
-from laserpick.pipeline.rrt import FINE_STEP_SHARE, rrt_connect, shortcut
+from laserpick.pipeline.rrt import shortcut
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
@@ -175,31 +175,6 @@ def test_joint_path_says_none_where_the_goal_is_walled_in(planner):
     # Without the mould the same move is the straight one.
     open_space = CollisionChecker(EMPTY)
     assert len(joint_path(start, goal, open_space, np.random.default_rng(0), s)) == 2
-
-
-class _Pocket:
-    """A joint space (rad) whose goal sits in a pocket that only short moves leave: any
-    move longer than `short` with an end within `pocket` of the goal is blocked, as every
-    full step is for a tall box held low in the basket a centimetre off its walls."""
-
-    def __init__(self, goal: np.ndarray, short: float, pocket: float) -> None:
-        self.goal, self.short, self.pocket = goal, short, pocket
-
-    def segment_ok(self, a: np.ndarray, b: np.ndarray, **kw) -> bool:
-        near = min(np.abs(a - self.goal).max(), np.abs(b - self.goal).max()) < self.pocket
-        return not near or np.abs(b - a).max() <= self.short
-
-
-def test_the_search_leaves_a_goal_that_only_short_steps_leave():
-    """The goal's tree grows out of its pocket in short steps: with full steps only, no
-    edge ever leaves the goal, and every sample was spent."""
-    step = get_settings().motion.rrt_step
-    start, goal = dims.UR5_READY_Q, dims.UR5_READY_Q + 1.0
-    pocket = _Pocket(goal, short=1.2 * step * FINE_STEP_SHARE, pocket=0.6 * step)
-    path = rrt_connect(start, goal, pocket, np.random.default_rng(0), step=step, max_samples=500)
-    assert path is not None
-    assert np.allclose(path[0], start) and np.allclose(path[-1], goal)
-    assert all(pocket.segment_ok(a, b) for a, b in itertools.pairwise(path))
 
 
 def test_shortcut_does_not_check_a_blocked_join_twice():

@@ -16,11 +16,6 @@ from laserpick.pipeline.collision import CollisionChecker
 
 __all__ = ["rrt_connect", "search_bounds", "shortcut"]
 
-#: A step toward a sample blocked at the full step is tried again at this share of it: where
-#: a node stands in a narrow space no full step leaves it (a tall box held low in the basket,
-#: a centimetre off its walls), and a tree rooted there would never grow.
-FINE_STEP_SHARE = 0.25
-
 
 def search_bounds(q_start: np.ndarray, q_goal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The box (lo, hi) (6,) rad that samples are drawn from: the joint limits, within a half
@@ -71,18 +66,12 @@ def rrt_connect(
     """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
 
     Two trees grow toward random samples within the joint limits and toward each other, in
-    steps of at most `step` rad (largest joint); each new edge is collision-checked. The
-    smaller tree draws the next sample (Kuffner and LaValle alternate), and its step toward
-    it, blocked, is tried again at `FINE_STEP_SHARE` of it: a tree rooted in a narrow space
-    (a goal that holds a tall box low in the basket) grows out of it while the other
-    spreads through the open space. On 58 searches recorded in `isolation` (four trials),
-    three runs each (`bench/planners.py`), this found 167 of 174 paths against 154
-    alternating with full steps only, in about the same CPU time (165 s against 156 s).
+    steps of at most `step` rad (largest joint); each new edge is collision-checked.
     """
     lo, hi = search_bounds(q_start, q_goal)
     trees = [([np.asarray(q_start, float)], [-1]), ([np.asarray(q_goal, float)], [-1])]
 
-    def extend(tree, target: np.ndarray, fine: bool = False) -> tuple[str, int]:
+    def extend(tree, target: np.ndarray) -> tuple[str, int]:
         nodes, parents = tree
         near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
         delta = target - nodes[near]
@@ -90,12 +79,7 @@ def rrt_connect(
         reached = span <= step
         q_new = target if reached else nodes[near] + delta * (step / span)
         if not checker.segment_ok(nodes[near], q_new, **kw):
-            short = step * FINE_STEP_SHARE
-            if not fine or span <= short:
-                return "trapped", near
-            reached, q_new = False, nodes[near] + delta * (short / span)
-            if not checker.segment_ok(nodes[near], q_new, **kw):
-                return "trapped", near
+            return "trapped", near
         nodes.append(q_new)
         parents.append(near)
         return ("reached" if reached else "advanced"), len(nodes) - 1
@@ -110,7 +94,7 @@ def rrt_connect(
 
     for _ in range(max_samples):
         q_rand = rng.uniform(lo, hi)
-        status, a = extend(trees[0], q_rand, fine=True)
+        status, a = extend(trees[0], q_rand)
         if status != "trapped":
             q_new = trees[0][0][a]
             while True:  # connect: the other tree steps toward q_new until blocked or there
@@ -123,5 +107,5 @@ def rrt_connect(
                 if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
                     path = path[::-1]
                 return np.array(path)
-        trees.sort(key=lambda tree: len(tree[0]))
+        trees.reverse()
     return None
