@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BROAD_MIN", "BROAD_SLACK", "Ball", "balls"]
+__all__ = ["BROAD_MIN", "BROAD_SLACK", "Ball", "balls", "enclosing"]
 
 #: What a ball's radius adds (m): far above float rounding, far below any margin, so that a
 #: ball never passes over a sphere the exact test would catch.
@@ -33,6 +33,14 @@ class Ball:
     radius: np.ndarray
 
 
+def enclosing(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ball about the mean of each row of points (B, N, 3) (m) that holds them all: its
+    middle (B, 3) and radius (B,), m."""
+    middle = points.mean(axis=1)
+    offset = points - middle[:, None]
+    return middle, np.sqrt(np.einsum("bni,bni->bn", offset, offset)).max(axis=1)
+
+
 def balls(
     centres: np.ndarray, reach: np.ndarray, body: np.ndarray
 ) -> tuple[np.ndarray, list[Ball]]:
@@ -44,9 +52,6 @@ def balls(
     out = []
     for b in np.flatnonzero(counts >= BROAD_MIN):
         mine = np.flatnonzero(body == b)
-        group = centres[:, mine]
-        middle = group.mean(axis=1)
-        offset = group - middle[:, None]
-        spread = np.sqrt(np.einsum("bsi,bsi->bs", offset, offset)).max(axis=1)
+        middle, spread = enclosing(centres[:, mine])
         out.append(Ball(int(b), mine, middle, spread + reach[mine].max() + BROAD_SLACK))
     return few, out

@@ -13,7 +13,7 @@ from laserpick.description.kinematics import T_FLANGE_TCP
 from laserpick.description.shapes import body_frames
 from laserpick.pipeline.cloud import thin
 from laserpick.pipeline.collision.arm_spheres import SPHERES, sphere_centres
-from laserpick.pipeline.collision.broad_phase import BROAD_SLACK
+from laserpick.pipeline.collision.broad_phase import BROAD_SLACK, enclosing
 
 #: Radius (m) of each point of a held object's cloud, as carried by the hand.
 PAYLOAD_POINT_RADIUS = 0.01
@@ -55,9 +55,8 @@ def off_upper_links(frames: np.ndarray, held: np.ndarray, margin: float) -> np.n
     upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
     links = sphere_centres(frames)[:, upper]
     reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
-    middle = held.mean(axis=1, keepdims=True)
-    spread = np.linalg.norm(held - middle, axis=-1).max(axis=1)
-    apart = np.linalg.norm(links - middle, axis=-1)
+    middle, spread = enclosing(held)
+    apart = np.linalg.norm(links - middle[:, None], axis=-1)
     rows, near = np.nonzero(apart < spread[:, None] + reach + BROAD_SLACK)
     gap = np.linalg.norm(held[rows] - links[rows, near][:, None], axis=-1)
     clear = np.ones(len(held), bool)
