@@ -44,16 +44,17 @@ def held_clear_of_arm(Q: np.ndarray, payload: np.ndarray, margin: float) -> np.n
     `margin` (m) off the arm's own upper links (up to PAYLOAD_CLEAR_OF_BODY) at each
     configuration Q[b] (B, 6) (rad). The wrist links next to the hand are expected near it."""
     frames = body_frames(np.atleast_2d(Q))
-    return off_upper_links(frames, held_points(frames, payload), margin)
+    return off_upper_links(sphere_centres(frames), held_points(frames, payload), margin)
 
 
-def off_upper_links(frames: np.ndarray, held: np.ndarray, margin: float) -> np.ndarray:
-    """`held_clear_of_arm` for body frames (B, 7, 4, 4) and the held points where they are
-    (B, P, 3; m, `base`, `held_points`). Point by point only against the link spheres that
-    the ball about the points' mean, holding them all, comes within reach of: the held
-    object is mostly far from the upper arm, and its points are many."""
+def off_upper_links(centres: np.ndarray, held: np.ndarray, margin: float) -> np.ndarray:
+    """`held_clear_of_arm` for the arm's sphere centres (B, S, 3; m, `base`,
+    `sphere_centres`) and the held points where they are (B, P, 3; m, `base`,
+    `held_points`). Point by point only against the link spheres that the ball about the
+    points' mean, holding them all, comes within reach of: the held object is mostly far
+    from the upper arm, and its points are many."""
     upper = SPHERES.body <= PAYLOAD_CLEAR_OF_BODY
-    links = sphere_centres(frames)[:, upper]
+    links = centres[:, upper]
     reach = SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin
     middle, spread = enclosing(held)
     apart = np.linalg.norm(links - middle[:, None], axis=-1)

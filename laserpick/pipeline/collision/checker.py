@@ -115,15 +115,15 @@ class CollisionChecker:
         margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
         frames = body_frames(Q)
-        centres = sphere_centres(frames)
-        radius, body = SPHERES.radius, SPHERES.body
+        spheres = sphere_centres(frames)
+        centres, radius, body = spheres, SPHERES.radius, SPHERES.body
         if not hand:
             keep = ~SPHERES.hand
             centres, radius, body = centres[:, keep], radius[keep], body[keep]
         clear = np.ones(len(Q), bool)
         if payload is not None and len(payload):
             held = held_points(frames, payload)
-            clear &= off_upper_links(frames, held, margin)
+            clear &= off_upper_links(spheres, held, margin)
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
             body = np.append(body, np.full(len(payload), HAND_BODY))
