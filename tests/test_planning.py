@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import body_frames
 from laserpick.pipeline import plan as plan_module
+from laserpick.pipeline import rrt
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
@@ -27,6 +29,7 @@ from laserpick.pipeline.plan import (
     straight_lift,
     transit_path,
 )
+from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut
 from laserpick.settings import MotionSettings, get_settings
@@ -175,6 +178,21 @@ def test_joint_path_says_none_where_the_goal_is_walled_in(planner):
     # Without the mould the same move is the straight one.
     open_space = CollisionChecker(EMPTY)
     assert len(joint_path(start, goal, open_space, np.random.default_rng(0), s)) == 2
+
+
+def test_a_tree_in_a_pocket_steps_out_with_shorter_steps(monkeypatch):
+    """A cereal box's carry recorded in `isolation` (seed 8): held by its top, the box hangs
+    low in the basket at the goal, where 0 of 64 full steps are clear. The goal's tree steps
+    out with quarter steps (`rrt.POCKET_TRAPS`) and the search ends; with full steps only,
+    it spends every sample."""
+    q0, q1, checker, kw = load_search(Path(__file__).parent / "data" / "cereal_box_carry.npz")
+    s = get_settings().motion
+    found = rrt.rrt_connect(q0, q1, checker, np.random.default_rng(0), step=s.rrt_step, **kw)
+    assert found is not None
+    assert all(checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(found))
+    monkeypatch.setattr(rrt, "POCKET_TRAPS", 10**9)
+    full = rrt.rrt_connect(q0, q1, checker, np.random.default_rng(0), step=s.rrt_step, **kw)
+    assert full is None
 
 
 def test_shortcut_does_not_check_a_blocked_join_twice():

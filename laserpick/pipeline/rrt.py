@@ -16,6 +16,17 @@ from laserpick.pipeline.collision import CollisionChecker
 
 __all__ = ["rrt_connect", "search_bounds", "shortcut"]
 
+#: A tree that meets this many blocked steps before it has POCKET_NODES nodes grows from a
+#: pocket, and steps POCKET_STEP of the full step while it is that small: a tall box held
+#: low in the basket meets a wall with almost every full step (0 or 1 of 64 directions
+#: clear). Replayed (`bench/planners.py`, two runs each), the 19 carries of a cereal box
+#: recorded in `isolation` seeds 3 and 8 were found in 25 of 38 runs against 14, the 58
+#: other recorded searches of seeds 1, 3, 8 and 10 in 101 of 116 against 99, both with less
+#: CPU.
+POCKET_TRAPS = 20
+POCKET_NODES = 30
+POCKET_STEP = 0.25
+
 
 def search_bounds(q_start: np.ndarray, q_goal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The box (lo, hi) (6,) rad that samples are drawn from: the joint limits, within a half
@@ -66,26 +77,30 @@ def rrt_connect(
     """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
 
     Two trees grow toward random samples within the joint limits and toward each other, in
-    steps of at most `step` rad (largest joint); each new edge is collision-checked.
+    steps of at most `step` rad (largest joint); each new edge is collision-checked. A tree
+    still small after many blocked steps takes shorter ones (POCKET_TRAPS).
     """
     lo, hi = search_bounds(q_start, q_goal)
-    trees = [([np.asarray(q_start, float)], [-1]), ([np.asarray(q_goal, float)], [-1])]
+    trees = [([np.asarray(q_start, float)], [-1], [0]), ([np.asarray(q_goal, float)], [-1], [0])]
 
     def extend(tree, target: np.ndarray) -> tuple[str, int]:
-        nodes, parents = tree
+        nodes, parents, traps = tree
         near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
         delta = target - nodes[near]
         span = float(np.max(np.abs(delta)))
-        reached = span <= step
-        q_new = target if reached else nodes[near] + delta * (step / span)
+        pocket = len(nodes) < POCKET_NODES and traps[0] >= POCKET_TRAPS
+        reach = step * POCKET_STEP if pocket else step
+        reached = span <= reach
+        q_new = target if reached else nodes[near] + delta * (reach / span)
         if not checker.segment_ok(nodes[near], q_new, **kw):
+            traps[0] += 1
             return "trapped", near
         nodes.append(q_new)
         parents.append(near)
         return ("reached" if reached else "advanced"), len(nodes) - 1
 
     def branch(tree, index: int) -> list[np.ndarray]:
-        nodes, parents = tree
+        nodes, parents, _ = tree
         out = []
         while index >= 0:
             out.append(nodes[index])
