@@ -6,6 +6,7 @@ Record problems by running any bench with LASERPICK_RECORD_PLANS set: every sear
 in turn (so both meet the same machine load), with the motion settings' sample budget:
 
 - ours: `rrt.rrt_connect` (extension step `rrt_step`, largest joint) and `rrt.shortcut`;
+  with `--full-steps`, also without its shorter steps out of a pocket (`rrt.POCKET_TRAPS`);
 - ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker).
 
 Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s),
@@ -32,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from laserpick.pipeline import rrt
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.ompl_search import OMPL_RANGE, ompl_connect
 from laserpick.pipeline.plan_record import load_search
@@ -47,6 +49,15 @@ Planner = Callable[
 def ours(q0, q1, checker, rng, s, kw):
     path = rrt_connect(q0, q1, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw)
     return None if path is None else shortcut(path, checker, rng, **kw)
+
+
+def ours_full_steps(q0, q1, checker, rng, s, kw):
+    """Ours without the shorter steps out of a pocket (`rrt.POCKET_TRAPS`)."""
+    traps, rrt.POCKET_TRAPS = rrt.POCKET_TRAPS, 10**9
+    try:
+        return ours(q0, q1, checker, rng, s, kw)
+    finally:
+        rrt.POCKET_TRAPS = traps
 
 
 def ompl_with(search_range: float) -> Planner:
@@ -151,9 +162,16 @@ def main() -> None:
         default=[OMPL_RANGE],
         help="OMPL RRT-Connect extension steps (rad, Euclidean) to compare",
     )
+    ap.add_argument(
+        "--full-steps",
+        action="store_true",
+        help="also ours without the shorter steps out of a pocket (rrt.POCKET_TRAPS)",
+    )
     args = ap.parse_args()
     files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
     planners: dict[str, Planner] = {"ours": ours}
+    if args.full_steps:
+        planners["ours, full steps"] = ours_full_steps
     for r in args.ranges:
         planners[f"ompl (range {r:.2f})"] = ompl_with(r)
     print(f"{len(files)} problems, {args.seeds} seeds each")

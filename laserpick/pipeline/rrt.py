@@ -19,10 +19,9 @@ __all__ = ["rrt_connect", "search_bounds", "shortcut"]
 #: A tree that meets this many blocked steps before it has POCKET_NODES nodes grows from a
 #: pocket, and steps POCKET_STEP of the full step while it is that small: a tall box held
 #: low in the basket meets a wall with almost every full step (0 or 1 of 64 directions
-#: clear). Replayed (`bench/planners.py`, two runs each), the 19 carries of a cereal box
-#: recorded in `isolation` seeds 3 and 8 were found in 25 of 38 runs against 14, the 58
-#: other recorded searches of seeds 1, 3, 8 and 10 in 101 of 116 against 99, both with less
-#: CPU.
+#: clear). Replayed (`bench/planners.py --full-steps`, two runs each), the 42 searches
+#: recorded in `isolation` seeds 3 and 8, 19 of them a cereal box's carries, were found in
+#: 71 of 84 runs against 60, with 29 % less CPU (docs/pipeline.md).
 POCKET_TRAPS = 20
 POCKET_NODES = 30
 POCKET_STEP = 0.25
