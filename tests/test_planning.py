@@ -254,9 +254,13 @@ def test_plan_pick_approaches_straight_and_lifts_within_the_limits():
     for traj in (plan.transit, plan.approach, plan.regrip, plan.lift):
         qd = np.diff(traj.q, axis=0) / np.diff(traj.times)[:, None]
         assert np.abs(qd).max() <= s.joint_speed * 1.02
-    tcp = tcp_pose(plan.approach.q)[:, :3, 3]
-    v = np.linalg.norm(np.diff(tcp, axis=0), axis=1) / np.diff(plan.approach.times)
-    assert v.max() <= s.approach_speed * 1.05
+    for traj, speed in ((plan.approach, s.approach_speed), (plan.regrip, s.approach_speed)):
+        tcp = tcp_pose(traj.q)[:, :3, 3]
+        v = np.linalg.norm(np.diff(tcp, axis=0), axis=1) / np.diff(traj.times)
+        assert v.max() <= speed * 1.05
+    tcp = tcp_pose(plan.lift.q)[:, :3, 3]
+    v = np.linalg.norm(np.diff(tcp, axis=0), axis=1) / np.diff(plan.lift.times)
+    assert s.approach_speed < v.max() <= s.lift_speed * 1.05  # the lift at its own speed
 
 
 def test_from_the_stowed_arm_the_transit_goes_out_through_the_unstow_pose():

@@ -29,14 +29,20 @@ class Withdrawing(GuardedMotion):
         *,
         level: bool = True,
     ) -> Failure | None:
-        """Draw the hand back the way `withdrawal_path` finds; stay where it finds none."""
+        """Draw the hand back the way `withdrawal_path` finds; stay where it finds none.
+        Holding `payload`, at the lift's speed (`lift_speed`), else at the approach's."""
         path = self.withdrawal_path(approach, checker, payload, level=level)
-        return None if path is None else self.run_withdrawal(path)
-
-    def run_withdrawal(self, path: np.ndarray) -> Failure | None:
-        """Run a way back (N, 6) that `withdrawal_path` found, at the approach's speed."""
+        if path is None:
+            return None
         s = self.settings.motion
-        return self.run(timed(path, s, tcp_speed=s.approach_speed), "drawing back")
+        return self.run_withdrawal(path, s.lift_speed if payload is not None else None)
+
+    def run_withdrawal(self, path: np.ndarray, speed: float | None = None) -> Failure | None:
+        """Run a way back (N, 6) that `withdrawal_path` found, at TCP `speed` (m/s; default:
+        the approach's)."""
+        s = self.settings.motion
+        speed = s.approach_speed if speed is None else speed
+        return self.run(timed(path, s, tcp_speed=speed), "drawing back")
 
     def withdrawal_path(
         self,

@@ -373,7 +373,7 @@ def plan_pick(
         transit=timed(transit[0], s, clear=transit[1]),
         approach=timed(approach, s, tcp_speed=s.approach_speed),
         regrip=timed(up, s, tcp_speed=s.approach_speed),
-        lift=timed(lift, s, tcp_speed=s.approach_speed),
+        lift=timed(lift, s, tcp_speed=s.lift_speed),
         q_grasp=q_grasp,
         q_lifted=lift[-1],
     )
