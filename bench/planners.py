@@ -33,11 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-from laserpick.pipeline import rrt
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.ompl_search import OMPL_RANGE, ompl_connect
 from laserpick.pipeline.plan_record import load_search
-from laserpick.pipeline.rrt import rrt_connect, shortcut
+from laserpick.pipeline.rrt import POCKET_TRAPS, rrt_connect, shortcut
 from laserpick.settings import MotionSettings, get_settings
 
 Planner = Callable[
@@ -46,18 +45,23 @@ Planner = Callable[
 ]
 
 
-def ours(q0, q1, checker, rng, s, kw):
-    path = rrt_connect(q0, q1, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw)
+def ours(q0, q1, checker, rng, s, kw, pocket_traps: int | None = POCKET_TRAPS):
+    path = rrt_connect(
+        q0,
+        q1,
+        checker,
+        rng,
+        step=s.rrt_step,
+        max_samples=s.rrt_max_samples,
+        pocket_traps=pocket_traps,
+        **kw,
+    )
     return None if path is None else shortcut(path, checker, rng, **kw)
 
 
 def ours_full_steps(q0, q1, checker, rng, s, kw):
     """Ours without the shorter steps out of a pocket (`rrt.POCKET_TRAPS`)."""
-    traps, rrt.POCKET_TRAPS = rrt.POCKET_TRAPS, 10**9
-    try:
-        return ours(q0, q1, checker, rng, s, kw)
-    finally:
-        rrt.POCKET_TRAPS = traps
+    return ours(q0, q1, checker, rng, s, kw, pocket_traps=None)
 
 
 def ompl_with(search_range: float) -> Planner:

@@ -180,7 +180,7 @@ def test_joint_path_says_none_where_the_goal_is_walled_in(planner):
     assert len(joint_path(start, goal, open_space, np.random.default_rng(0), s)) == 2
 
 
-def test_a_tree_in_a_pocket_steps_out_with_shorter_steps(monkeypatch):
+def test_a_tree_in_a_pocket_steps_out_with_shorter_steps():
     """A cereal box's carry recorded in `isolation` (seed 8): held by its top, the box hangs
     low in the basket at the goal, where 0 of 64 full steps are clear. The goal's tree steps
     out with quarter steps (`rrt.POCKET_TRAPS`) and the search ends; with full steps only,
@@ -190,9 +190,8 @@ def test_a_tree_in_a_pocket_steps_out_with_shorter_steps(monkeypatch):
     found = rrt.rrt_connect(q0, q1, checker, np.random.default_rng(0), step=s.rrt_step, **kw)
     assert found is not None
     assert all(checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(found))
-    monkeypatch.setattr(rrt, "POCKET_TRAPS", 10**9)
-    full = rrt.rrt_connect(q0, q1, checker, np.random.default_rng(0), step=s.rrt_step, **kw)
-    assert full is None
+    rng = np.random.default_rng(0)
+    assert rrt.rrt_connect(q0, q1, checker, rng, step=s.rrt_step, pocket_traps=None, **kw) is None
 
 
 def test_shortcut_does_not_check_a_blocked_join_twice():

@@ -71,13 +71,15 @@ def rrt_connect(
     *,
     step: float = 0.3,
     max_samples: int = 2000,
+    pocket_traps: int | None = POCKET_TRAPS,
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
 
     Two trees grow toward random samples within the joint limits and toward each other, in
     steps of at most `step` rad (largest joint); each new edge is collision-checked. A tree
-    still small after many blocked steps takes shorter ones (POCKET_TRAPS).
+    still small after `pocket_traps` blocked steps takes shorter ones (POCKET_TRAPS; None:
+    never).
     """
     lo, hi = search_bounds(q_start, q_goal)
     trees = [([np.asarray(q_start, float)], [-1], [0]), ([np.asarray(q_goal, float)], [-1], [0])]
@@ -87,7 +89,7 @@ def rrt_connect(
         near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
         delta = target - nodes[near]
         span = float(np.max(np.abs(delta)))
-        pocket = len(nodes) < POCKET_NODES and traps[0] >= POCKET_TRAPS
+        pocket = pocket_traps is not None and len(nodes) < POCKET_NODES and traps[0] >= pocket_traps
         reach = step * POCKET_STEP if pocket else step
         reached = span <= reach
         q_new = target if reached else nodes[near] + delta * (reach / span)
