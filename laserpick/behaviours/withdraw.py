@@ -35,7 +35,7 @@ class Withdrawing(GuardedMotion):
         if path is None:
             return None
         s = self.settings.motion
-        return self.run_withdrawal(path, s.lift_speed if payload is not None else None)
+        return self.run_withdrawal(path, s.lift_speed if payload is not None else s.approach_speed)
 
     def run_withdrawal(self, path: np.ndarray, speed: float | None = None) -> Failure | None:
         """Run a way back (N, 6) that `withdrawal_path` found, at TCP `speed` (m/s; default:

@@ -63,6 +63,29 @@ def shortcut(
     return np.array([points[k] for k in keep])
 
 
+class _Tree:
+    """One tree of the search: its nodes (rad), each one's parent (-1: the root), and how
+    many of its steps were blocked."""
+
+    def __init__(self, root: np.ndarray) -> None:
+        self.nodes = [root]
+        self.parents = [-1]
+        self.blocked = 0
+
+    def in_pocket(self, traps: int | None) -> bool:
+        """Whether it is still under POCKET_NODES nodes after `traps` blocked steps (None:
+        never)."""
+        return traps is not None and len(self.nodes) < POCKET_NODES and self.blocked >= traps
+
+    def branch(self, index: int) -> list[np.ndarray]:
+        """The nodes from node `index` back to the root."""
+        out = []
+        while index >= 0:
+            out.append(self.nodes[index])
+            index = self.parents[index]
+        return out
+
+
 def rrt_connect(
     q_start: np.ndarray,
     q_goal: np.ndarray,
@@ -82,43 +105,34 @@ def rrt_connect(
     never).
     """
     lo, hi = search_bounds(q_start, q_goal)
-    trees = [([np.asarray(q_start, float)], [-1], [0]), ([np.asarray(q_goal, float)], [-1], [0])]
+    trees = [_Tree(np.asarray(q_start, float)), _Tree(np.asarray(q_goal, float))]
 
-    def extend(tree, target: np.ndarray) -> tuple[str, int]:
-        nodes, parents, traps = tree
+    def extend(tree: _Tree, target: np.ndarray) -> tuple[str, int]:
+        nodes = tree.nodes
         near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
         delta = target - nodes[near]
         span = float(np.max(np.abs(delta)))
-        pocket = pocket_traps is not None and len(nodes) < POCKET_NODES and traps[0] >= pocket_traps
-        reach = step * POCKET_STEP if pocket else step
+        reach = step * POCKET_STEP if tree.in_pocket(pocket_traps) else step
         reached = span <= reach
         q_new = target if reached else nodes[near] + delta * (reach / span)
         if not checker.segment_ok(nodes[near], q_new, **kw):
-            traps[0] += 1
+            tree.blocked += 1
             return "trapped", near
         nodes.append(q_new)
-        parents.append(near)
+        tree.parents.append(near)
         return ("reached" if reached else "advanced"), len(nodes) - 1
-
-    def branch(tree, index: int) -> list[np.ndarray]:
-        nodes, parents, _ = tree
-        out = []
-        while index >= 0:
-            out.append(nodes[index])
-            index = parents[index]
-        return out
 
     for _ in range(max_samples):
         q_rand = rng.uniform(lo, hi)
         status, a = extend(trees[0], q_rand)
         if status != "trapped":
-            q_new = trees[0][0][a]
+            q_new = trees[0].nodes[a]
             while True:  # connect: the other tree steps toward q_new until blocked or there
                 status, b = extend(trees[1], q_new)
                 if status != "advanced":
                     break
             if status == "reached":
-                half_a, half_b = branch(trees[0], a), branch(trees[1], b)
+                half_a, half_b = trees[0].branch(a), trees[1].branch(b)
                 path = half_a[::-1] + half_b[1:]
                 if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
                     path = path[::-1]
