@@ -139,6 +139,43 @@ def test_an_open_hand_among_what_it_let_go_of_rises_clear_before_it_stows(robot)
     assert tcp_pose(robot.joint_state().q)[2, 3] > T[2, 3] + 0.04
 
 
+def test_an_open_hand_rising_off_what_it_let_go_of_keeps_clear_of_all_else(robot):
+    """Let go of a tall can over the basket, the hand rises among the can's points, which it
+    may pass; but not into what stands beside its way up (the projector's post): unchecked,
+    it rose into the post, and no way to ready or to the stowed pose could start there. A
+    post's edge 7 cm beside the hand's axis, from 7 cm above the TCP up, clear of the wrist
+    as it rises but not of the housing: the hand does not rise into it."""
+    b = Behaviours(robot)
+    assert b.go_ready().ok
+    q0 = robot.joint_state().q
+    T = tcp_pose(q0)
+    xs = np.linspace(-0.02, 0.02, 5)
+    top = np.array([[T[0, 3] + x, T[1, 3] + y, T[2, 3]] for x in xs for y in xs])
+    heights = np.arange(0.07, 0.36, 0.01)
+    post = np.array([[T[0, 3] + x, T[1, 3] + 0.07, T[2, 3] + z] for x in xs / 2 for z in heights])
+    beside = CollisionChecker(post, voxel=0.0)
+    around = CollisionChecker(np.vstack([top, post]), voxel=0.0)
+    assert beside.clearance_ok(q0)[0] and not around.clearance_ok(q0)[0]
+    assert b.rise_clear(around, hand_on_the_way=beside) is None
+    assert beside.clearance_ok(robot.joint_state().q)[0], "the hand kept clear of the post"
+    # With the post 5 cm higher, it rises one step, through the can's top, and is clear.
+    higher = CollisionChecker(post + [0.0, 0.0, 0.05], voxel=0.0)
+    assert (
+        b.rise_clear(
+            CollisionChecker(np.vstack([top, higher.points]), voxel=0.0), hand_on_the_way=higher
+        )
+        is None
+    )
+    q = robot.joint_state().q
+    assert tcp_pose(q)[2, 3] - T[2, 3] == pytest.approx(0.05, abs=0.01)
+    assert higher.clearance_ok(q)[0] and CollisionChecker(top, voxel=0.0).clearance_ok(q)[0]
+    assert b.go_ready().ok
+    # Unchecked, the same rise runs the hand into it.
+    assert b.rise_clear(around, hand_on_the_way=False) is None
+    q = robot.joint_state().q
+    assert not beside.clearance_ok(q)[0] and beside.clearance_ok(q, hand=False)[0]
+
+
 def test_an_arm_let_down_within_the_margin_of_a_surface_rises_away_from_it(robot):
     """A place may let the forearm down nearer a surface than the margin (it must only not
     reach into the support): set down on the 31 cm table, a cereal box leaves it 4 mm above

@@ -59,7 +59,7 @@ class Carrying(GuardedMotion):
         checker: CollisionChecker,
         payload: np.ndarray | None = None,
         *,
-        hand_on_the_way: bool = True,
+        hand_on_the_way: bool | CollisionChecker = True,
     ) -> Failure | None:
         """Lift straight up, `rise_step` at a time and at most `rise_max`, until the arm,
         the hand and what it holds (`payload`, in the TCP frame) are clear of `checker`: a
@@ -72,7 +72,10 @@ class Carrying(GuardedMotion):
         may instead rise and reach out `rise_out`, away from the arm's mount, which keeps the
         elbow forward: only where that step ends with the object clear (out of a shelf's
         gap, it would carry the object deeper in). hand_on_the_way: whether the hand is kept
-        clear on each step too (not when it starts among what it let go of)."""
+        clear of `checker` on each step too; or, where it starts among what it let go of,
+        the checker of all but that, which the hand is kept clear of instead (unchecked, an
+        open hand rose off a chip can into the projector's post over the basket, and no way
+        left from there)."""
         s, b = self.settings.motion, self.settings.behaviour
         risen = 0.0
         while not checker.clearance_ok(self.current_q(), payload=payload)[0]:
@@ -88,19 +91,24 @@ class Carrying(GuardedMotion):
         return None
 
     def _rise_step_path(
-        self, checker: CollisionChecker, payload: np.ndarray | None, hand: bool
+        self,
+        checker: CollisionChecker,
+        payload: np.ndarray | None,
+        hand: bool | CollisionChecker,
     ) -> np.ndarray | None:
         """The joint path (N, 6) of one `rise_step` up that keeps the arm (and the hand, if
-        `hand`) clear of `checker`: straight, or, holding `payload`, reaching out `rise_out`
-        from the arm's mount where that brings the payload clear. None when neither does.
-        Clear, where the arm starts within the checker's margin, means keeping at least the
+        `hand` is True) clear of `checker`, and the hand clear of `hand` where that is a
+        checker: straight, or, holding `payload`, reaching out `rise_out` from the arm's
+        mount where that brings the payload clear. None when neither does.
+        Clear, where the arm starts within a checker's margin, means keeping at least the
         clearance it starts with (`clearance_kept`): an object set down on a low table can
         leave the forearm a few millimetres above the top, and a rise held to the full
         margin could not leave."""
         b = self.settings.behaviour
         q = self.current_q()
-        kept = checker.clearance_kept(q, hand=hand)
-        if kept is None:
+        kept = checker.clearance_kept(q, hand=hand is True)
+        hand_kept = hand.clearance_kept(q) if isinstance(hand, CollisionChecker) else 0.0
+        if kept is None or hand_kept is None:
             return None
         here = tcp_pose(q)
         out = here[:2, 3] - dims.ARM_MOUNT_POS[:2]
@@ -110,7 +118,12 @@ class Carrying(GuardedMotion):
             T[:2, 3] += reach * out
             T[2, 3] += b.rise_step
             path = cartesian_line(q, T, self.settings.motion.cartesian_step)
-            if path is None or not checker.clearance_ok(path, hand=hand, margin=kept).all():
+            if path is None or not checker.clearance_ok(path, hand=hand is True, margin=kept).all():
+                continue
+            if (
+                isinstance(hand, CollisionChecker)
+                and not hand.clearance_ok(path, margin=hand_kept).all()
+            ):
                 continue
             if reach == 0.0 or checker.clearance_ok(path[-1], payload=payload)[0]:
                 return path

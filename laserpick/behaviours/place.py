@@ -144,9 +144,10 @@ class Placing(Carrying, Leaving, Stowing):
         standing = held.standing_at(T_release)
         seen = np.vstack([checker.points, self.seen_without_arm()])
         around = CollisionChecker(np.vstack([seen, standing]), margin=s.clearance, filtered=True)
+        without = CollisionChecker(seen, margin=s.clearance, filtered=True)
         # A guard stop short of the surface (the wrist met the floor) leaves the straight
         # rise short of clearing the object.
-        failure = self.rise_clear(around, hand_on_the_way=False)
+        failure = self.rise_clear(around, hand_on_the_way=without)
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot)
         # First around a wall under the surface's seen front (`surface_front`: a counter's
@@ -159,7 +160,7 @@ class Placing(Carrying, Leaving, Stowing):
             # The object as held can stand for more than it is (a plush toy's mirrored
             # back), and the hand drawn back out of it still stands inside it: around what
             # the cameras see alone, a way home is found.
-            back = self.stow(CollisionChecker(seen, margin=s.clearance, filtered=True))
+            back = self.stow(without)
         if back.failure is not None:
             msg = back.failure.message
             failure = Failure(back.failure.kind, f"Set down; then {msg[:1].lower()}{msg[1:]}")
