@@ -8,18 +8,22 @@ from dataclasses import replace
 
 import numpy as np
 
-from laserpick.behaviours.carry import Carrying, holding_pose
-from laserpick.behaviours.drop_postures import drop_configurations, past_the_opening
+from laserpick.behaviours.basket_way import BasketWay, drop_postures_for, path_to_a_drop
+from laserpick.behaviours.carry import Carrying
+from laserpick.behaviours.drop_postures import past_the_opening
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.messages import NOT_HOLDING, PAST_THE_OPENING
-from laserpick.behaviours.outcome import SEARCH, Outcome
+from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.stow import Stowing
-from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.types import Failure
 
 __all__ = ["BasketDrop"]
+
+
+#: The progress message as the carry to the basket starts.
+CARRYING = "Carrying the object to the basket."
 
 
 class BasketDrop(Carrying, Stowing):
@@ -49,40 +53,56 @@ class BasketDrop(Carrying, Stowing):
         return replace(left, timings=out.timings)
 
     def _carry_to_basket(self, held: Held) -> Outcome:
-        """Rise clear, then carry `held` to the first of the best `drop_tries` postures over
-        the basket that a path reaches. The outcome's timings hold the wall-clock seconds
-        spent choosing the postures and searching the paths (`CARRY_PLANNING`)."""
-        b = self.settings.behaviour
-        t0 = time.perf_counter()
-        drops = drop_configurations(
-            self.current_q(),
-            held.surroundings,
-            held.points_tcp,
-            held.as_seen_tcp,
-            settings=b,
-            motion=self.settings.motion,
-        )
-        planning = time.perf_counter() - t0
-        if not drops:
+        """Carry `held` to the first of the best `drop_tries` postures over the basket that a
+        path reaches: as searched ahead while the pick lifted it (`basket_way`), or searched
+        now, after rising clear (`_search_basket_way`). The outcome's timings hold the
+        wall-clock seconds the arm stood still for the postures and the paths to be found
+        (`CARRY_PLANNING`)."""
+        way, planning = self._way_searched_ahead(held)
+        if way is None:
+            way, searched = self._search_basket_way(held)
+            planning += searched
+            if isinstance(way, Failure):
+                return Outcome(way).planned_for(planning)
+        if not way.drops:
             msg = "The arm cannot hold the object over the basket; it keeps it."
             return Outcome(Failure("ik_plan", msg)).planned_for(planning)
-        self.progress("Carrying the object to the basket.")
+        if way.path is None:
+            msg = "No collision-free path was found for carrying to the basket."
+            return Outcome(Failure("ik_plan", msg)).planned_for(planning)
+        failure = self.follow(
+            way.path, held.surroundings, "carrying to the basket", payload=held.points_tcp
+        )
+        return Outcome(failure).planned_for(planning)
+
+    def _way_searched_ahead(self, held: Held) -> tuple[BasketWay | None, float]:
+        """The carry searched ahead for `held` from where the arm stands (None: none was,
+        or its start was not clear), and the seconds (s) the arm stood still for it."""
+        ahead, self.ahead = self.ahead, None
+        tolerance = self.settings.behaviour.start_tolerance
+        if ahead is None or not ahead.fits(held, self.current_q(), tolerance):
+            return None, 0.0
+        way, waited = ahead.result()
+        if way is not None and way.drops:
+            self.progress(CARRYING)
+        return way, waited
+
+    def _search_basket_way(self, held: Held) -> tuple[BasketWay | Failure, float]:
+        """The drop postures ranked from where the arm stands, then, risen clear
+        (`rise_clear`), the path to the first a search reaches; or why the rise failed.
+        With the seconds (s, wall clock) the arm stood still for them."""
+        t0 = time.perf_counter()
+        drops = drop_postures_for(self.current_q(), held, self.settings)
+        planning = time.perf_counter() - t0
+        if not drops:
+            return BasketWay(drops, None), planning
+        self.progress(CARRYING)
         failure = self.rise_clear(held.surroundings, held.points_tcp)
         if failure is not None:
-            return Outcome(failure).planned_for(planning)
-        high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
-        for q_drop in drops[: b.drop_tries]:
-            out = self.go_to(
-                q_drop,
-                held.surroundings,
-                "carrying to the basket",
-                via=(high,),
-                payload=held.points_tcp,
-            )
-            planning += out.timings[SEARCH]
-            if out.ok or out.failure is None or out.failure.kind != "ik_plan":
-                break  # there, or a motion was stopped: no other posture is tried
-        return out.planned_for(planning)
+            return failure, planning
+        t0 = time.perf_counter()
+        path = path_to_a_drop(self.current_q(), drops, held, self.settings, self.rng)
+        return BasketWay(drops, path), planning + time.perf_counter() - t0
 
     def _leave_basket(self, held: Held, let_go: np.ndarray) -> Outcome:
         """From over the basket, the open hand rises off the object (`let_go`, m, `base`)
@@ -96,7 +116,7 @@ class BasketDrop(Carrying, Stowing):
             margin=self.settings.motion.clearance,
             filtered=True,
         )
-        failure = self.rise_clear(around, hand_on_the_way=False)
+        failure = self.rise_clear(around, hand_on_the_way=held.surroundings)
         if failure is not None:
             return Outcome(failure)
         for leave in (self.go_ready, self.fold_away):

@@ -14,12 +14,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from laserpick.behaviours.ahead import Ahead
 from laserpick.behaviours.hand import wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import joint_path, timed
+from laserpick.pipeline.plan import joint_path_via, timed
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure, Trajectory
@@ -36,7 +37,9 @@ class GuardedMotion:
     should_stop: polled before every motion; once it returns True (the operator cancelled,
     or the watchdog fired) no new motion starts and the behaviour ends with a failure.
     held: what the hand holds (None: nothing); way_in: how it came to hold it, while that
-    way is known (every motion since the grasp ran to its end).
+    way is known (every motion since the grasp ran to its end); ahead: a search started for
+    the motion after the ones running (`Ahead`), taken up where the arm then stands at its
+    start.
     """
 
     def __init__(
@@ -54,6 +57,8 @@ class GuardedMotion:
         self.progress = progress or (lambda msg: log.info(msg))
         self.held: Held | None = None
         self.way_in: WayIn | None = None
+        #: the search for what the arm does next, running while it finishes what it does now
+        self.ahead: Ahead | None = None
 
     def current_q(self) -> np.ndarray:
         """The arm's joint angles now (6,) (rad)."""
@@ -130,34 +135,31 @@ class GuardedMotion:
         via: Sequence[np.ndarray] = (),
         **kw,
     ) -> Outcome:
-        """A collision-free joint move to q_goal (6,) rad; when no path is found, through
-        each configuration of `via` in turn (two shorter searches instead of one long).
+        """A collision-free joint move to q_goal (6,) rad (`joint_path_via`, then `follow`).
         kw: passed to `joint_path` (`payload`, TCP frame: what the hand carries, which also
         slows the move to the carrying speed, `joint_speed_for`). The outcome's timings
         give the wall-clock seconds the search took (`SEARCH`)."""
-        s, q = self.settings.motion, self.current_q()
-        t0 = time.perf_counter()
-        path = joint_path(q, q_goal, checker, self.rng, s, **kw)
-        for q_via in via:
-            if path is not None:
-                break
-            first = joint_path(q, q_via, checker, self.rng, s, **kw)
-            second = (
-                joint_path(q_via, q_goal, checker, self.rng, s, **kw) if first is not None else None
-            )
-            path = None if second is None else np.vstack([first, second[1:]])
+        s, t0 = self.settings.motion, time.perf_counter()
+        path = joint_path_via(self.current_q(), q_goal, checker, self.rng, s, via, **kw)
         searched = {SEARCH: time.perf_counter() - t0}
         if path is None:
             msg = f"No collision-free path was found for {what}."
             return Outcome(Failure("ik_plan", msg), timings=searched)
+        return Outcome(self.follow(path, checker, what, **kw), timings=searched)
+
+    def follow(
+        self, path: np.ndarray, checker: CollisionChecker, what: str, **kw
+    ) -> Failure | None:
+        """Run the searched joint `path` (K, 6) rad (`run`), its corners blended where the
+        check it was searched with (`checker`, kw) passes, at the carrying speed where kw
+        has a `payload`."""
+        s = self.settings.motion
         speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
 
         def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
             return checker.clearance_ok(Q, **kw)
 
-        return Outcome(
-            self.run(timed(path, s, joint_speed=speed, clear=clear), what), timings=searched
-        )
+        return self.run(timed(path, s, joint_speed=speed, clear=clear), what)
 
     def descend(
         self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0
@@ -184,3 +186,4 @@ class GuardedMotion:
         wait_for_gripper(self.robot)
         self.held = None
         self.way_in = None
+        self.ahead = None

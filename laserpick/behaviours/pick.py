@@ -8,6 +8,10 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 
+import numpy as np
+
+from laserpick.behaviours.ahead import Ahead
+from laserpick.behaviours.basket_way import basket_way
 from laserpick.behaviours.carry import without_leftovers
 from laserpick.behaviours.drop_postures import holds_over_basket
 from laserpick.behaviours.hand import GRIPPER_TIME, closed_on_something, wait_for_gripper
@@ -40,7 +44,7 @@ class Picking(Withdrawing):
         if self.robot.gripper_state().holding:
             return Outcome(Failure("precondition", "The hand is already holding something."))
         order = list(order) if order is not None else grasps.ordered()
-        self.way_in = None
+        self.way_in = self.ahead = None
         t0 = time.perf_counter()
         admit = self._basket_admits(grasps) if to_basket else None
         plan, grasp, attempts = plan_first(grasps, self.current_q(), self.rng, order, s, admit)
@@ -55,13 +59,24 @@ class Picking(Withdrawing):
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
         held = self._take_hold(grasps, grasp, plan)
+        # Where the lift leaves the arm is known: the way back out of a side grasp, and from
+        # its end the carry to the basket, are searched while the arm lifts.
+        way_out = self.withdrawal_path(
+            grasp.approach, held.surroundings, held.points_tcp, q_from=plan.q_lifted
+        )
+        if to_basket:
+            q_from = plan.q_lifted if way_out is None else way_out[-1]
+            rng = np.random.default_rng(self.rng.integers(2**63))  # the thread's own
+            self.ahead = Ahead(
+                self.robot, q_from, held, lambda: basket_way(q_from, held, self.settings, rng)
+            )
         self.progress("Lifting the object.")
         failure, closed = self._regrip_and_lift(plan)
         if failure:
             if not self.should_stop():  # a cancel or an e-stop keeps what the hand holds
                 self.release()
             return Outcome(failure, grasp, attempts, timings, closed_width=closed)
-        failure = self.withdraw(grasp.approach, held.surroundings, held.points_tcp)
+        failure = None if way_out is None else self.run_withdrawal(way_out, s.lift_speed)
         if failure:  # the hand keeps what it holds: the session tucks it in
             return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         self.progress("Holding the object.")

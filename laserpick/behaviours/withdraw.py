@@ -51,10 +51,12 @@ class Withdrawing(GuardedMotion):
         payload: np.ndarray | None = None,
         *,
         level: bool = True,
+        q_from: np.ndarray | None = None,
     ) -> np.ndarray | None:
         """The joint path (N, 6) that draws the hand straight back along its `approach`
         (unit, `base`) by `approach_distance` (or half that where the whole is not clear of
-        `checker`, with `payload` in the hand); None where none is clear.
+        `checker`, with `payload` in the hand), from q_from (6,) rad (default: where the arm
+        stands); None where none is clear.
 
         level: after a lift from the side, back level, out of a shelf's gap before the arm
         swings anywhere (a swing planned from inside a shelf finds no way out, or meets the
@@ -77,7 +79,7 @@ class Withdrawing(GuardedMotion):
             if level
             else [-approach]
         )
-        q = self.current_q()
+        q = self.current_q() if q_from is None else q_from
         margins = (checker.margin, checker.margin / 2, 0.0)
         margin = next(
             (m for m in margins if checker.clearance_ok(q, payload=payload, margin=m)[0]), None

@@ -39,8 +39,9 @@ FAILURE_KINDS = (
     "execute",
 )
 #: The stages timed per attempt (s). All but execute_sim are wall-clock time of the pipeline;
-#: plan_carry is the planning done while the hand holds the object (its postures and paths to
-#: the basket, the tuck and the place), the arm standing still meanwhile; execute_sim is
+#: plan_carry is the planning the arm stands still for while the hand holds the object (its
+#: postures and paths to the basket, the tuck and the place; the way to the basket is searched
+#: while the arm lifts, and counts only where it outlasts the lift: `Ahead`); execute_sim is
 #: simulated time from "go" until the hand lets go of the object (in the basket or at the
 #: place mark); attempt_total is their sum.
 STAGES = (

@@ -82,6 +82,27 @@ def joint_path(
     return min((path, quick), key=lambda p: timed(p, s, joint_speed=speed).duration)
 
 
+def joint_path_via(
+    q_start: np.ndarray,
+    q_goal: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    via: Sequence[np.ndarray] = (),
+    **kw,
+) -> np.ndarray | None:
+    """`joint_path`; where it finds none, through each configuration of `via` (6,) rad in
+    turn: two shorter searches instead of one long. None where no search found a path."""
+    path = joint_path(q_start, q_goal, checker, rng, s, **kw)
+    for q_via in via:
+        if path is not None:
+            break
+        first = joint_path(q_start, q_via, checker, rng, s, **kw)
+        second = joint_path(q_via, q_goal, checker, rng, s, **kw) if first is not None else None
+        path = None if second is None else np.vstack([first, second[1:]])
+    return path
+
+
 @dataclass
 class Searches:
     """The joint-space searches of one pick, shared by the grasps it tries: a leg already

@@ -1,0 +1,80 @@
+"""The way of what the hand holds to the basket: the postures that let it go over the
+opening, best first, and the joint path to the first a search reaches. Pure planning, read
+from nothing of the robot: it may run on a thread while the arm still lifts (`Ahead`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from laserpick.behaviours.carry import holding_pose
+from laserpick.behaviours.drop_postures import drop_configurations
+from laserpick.behaviours.held import Held
+from laserpick.description import dims
+from laserpick.pipeline.plan import joint_path_via
+from laserpick.settings import Settings
+
+__all__ = ["BasketWay", "basket_way", "drop_postures_for", "path_to_a_drop"]
+
+
+@dataclass(frozen=True)
+class BasketWay:
+    """The carry to the basket as searched: the postures that let the object go over it,
+    best first (rad), and the joint path (K, 6) rad to the first a search reached (None:
+    none did)."""
+
+    drops: list[np.ndarray]
+    path: np.ndarray | None
+
+
+def drop_postures_for(q_from: np.ndarray, held: Held, settings: Settings) -> list[np.ndarray]:
+    """The postures (6,) rad that let `held` go over the basket, best first, as the carry
+    from q_from (6,) rad reaches them (`drop_configurations`)."""
+    return drop_configurations(
+        q_from,
+        held.surroundings,
+        held.points_tcp,
+        held.as_seen_tcp,
+        settings=settings.behaviour,
+        motion=settings.motion,
+    )
+
+
+def path_to_a_drop(
+    q_from: np.ndarray,
+    drops: list[np.ndarray],
+    held: Held,
+    settings: Settings,
+    rng: np.random.Generator,
+) -> np.ndarray | None:
+    """The joint path (K, 6) rad from q_from to the first of the best `drop_tries` of
+    `drops` that a search with `rng` reaches, through the high ready pose where the straight
+    search finds none; None where none does."""
+    b = settings.behaviour
+    high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
+    for q_drop in drops[: b.drop_tries]:
+        path = joint_path_via(
+            q_from,
+            q_drop,
+            held.surroundings,
+            rng,
+            settings.motion,
+            via=(high,),
+            payload=held.points_tcp,
+        )
+        if path is not None:
+            return path
+    return None
+
+
+def basket_way(
+    q_from: np.ndarray, held: Held, settings: Settings, rng: np.random.Generator
+) -> BasketWay | None:
+    """The carry of `held` to the basket from q_from (6,) rad, searched with `rng`; None
+    where the arm and what it holds are not clear there (the carry first rises clear,
+    `Carrying.rise_clear`, and searches from where that leaves it)."""
+    if not held.surroundings.clearance_ok(q_from, payload=held.points_tcp)[0]:
+        return None
+    drops = drop_postures_for(q_from, held, settings)
+    return BasketWay(drops, path_to_a_drop(q_from, drops, held, settings, rng))
