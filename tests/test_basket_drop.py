@@ -27,6 +27,7 @@ from laserpick.behaviours import (
     NO_BASKET_HOLD,
     Behaviours,
     basket_opening,
+    basket_way,
     drop_candidates,
     drop_configurations,
     holds_over_basket,
@@ -85,7 +86,8 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     assert referee.position(name)[2] > TABLE_TOP + 0.08, "lifted"
     # The carry was searched while the arm lifted, from where the lift left it.
     tolerance = b.settings.behaviour.start_tolerance
-    assert b.ahead is not None and b.ahead.fits(b.held, robot.joint_state().q, tolerance)
+    owners = (basket_way, b.held, b.held.surroundings)
+    assert b.ahead is not None and b.ahead.fits(owners, robot.joint_state().q, tolerance)
     dropped = b.drop_in_basket()
     assert dropped.ok, dropped.failure
     assert dropped.caution is None, "let go wholly over the opening"

@@ -11,9 +11,11 @@ settings' `behaviour` group (`BehaviourSettings`, `LASERPICK_BEHAVIOUR__*`).
 
 from __future__ import annotations
 
+from laserpick.behaviours.ahead import Ahead
 from laserpick.behaviours.approach import Approaching
 from laserpick.behaviours.basket import BasketDrop
-from laserpick.behaviours.carry import Carrying, holding_pose, without_leftovers
+from laserpick.behaviours.basket_way import BasketWay, basket_way
+from laserpick.behaviours.carry import Carrying, holding_pose, tuck_way, without_leftovers
 from laserpick.behaviours.drop_postures import (
     basket_opening,
     drop_candidates,
@@ -47,8 +49,10 @@ __all__ = [
     "NOT_HOLDING",
     "NO_BASKET_HOLD",
     "PAST_THE_OPENING",
+    "Ahead",
     "Approaching",
     "BasketDrop",
+    "BasketWay",
     "Behaviours",
     "Carrying",
     "GuardedMotion",
@@ -63,6 +67,7 @@ __all__ = [
     "WayIn",
     "Withdrawing",
     "basket_opening",
+    "basket_way",
     "crowded_message",
     "drop_candidates",
     "drop_configurations",
@@ -72,6 +77,7 @@ __all__ = [
     "past_the_opening",
     "place_poses",
     "rank_drop_postures",
+    "tuck_way",
     "turned_hand_xy",
     "wait_for_gripper",
     "without_leftovers",

@@ -26,13 +26,14 @@ T = TypeVar("T")
 
 class Ahead(Generic[T]):
     """One search running ahead of the arm, for the motion that starts at `start` (6,) rad,
-    on behalf of `owner` (what it was searched for: a use for another is refused)."""
+    searched for `owners` (the objects it read: the held object and its surroundings; a use
+    where any of them was replaced is refused)."""
 
     def __init__(
-        self, robot: Robot, start: np.ndarray, owner: object, search: Callable[[], T]
+        self, robot: Robot, start: np.ndarray, owners: tuple[object, ...], search: Callable[[], T]
     ) -> None:
         self.start = np.array(start, float)
-        self.owner = owner
+        self.owners = owners
         self._robot = robot
         self._since = robot.joint_state().stamp
         self._done = threading.Event()
@@ -51,10 +52,13 @@ class Ahead(Generic[T]):
             self._wall = time.perf_counter() - t0
             self._done.set()
 
-    def fits(self, owner: object, q: np.ndarray, tolerance: float) -> bool:
-        """Whether this search is `owner`'s and starts within `tolerance` (rad, each joint)
-        of the arm's `q` (6,) rad."""
-        return owner is self.owner and float(np.max(np.abs(q - self.start))) <= tolerance
+    def fits(self, owners: tuple[object, ...], q: np.ndarray, tolerance: float) -> bool:
+        """Whether this search was for these very `owners` and starts within `tolerance`
+        (rad, each joint) of the arm's `q` (6,) rad."""
+        same = len(owners) == len(self.owners) and all(
+            a is b for a, b in zip(owners, self.owners, strict=True)
+        )
+        return same and float(np.max(np.abs(q - self.start))) <= tolerance
 
     def result(self) -> tuple[T, float]:
         """The search's result, once it is done, and how long (s) the arm stood still for it:

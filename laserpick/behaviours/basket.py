@@ -8,7 +8,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from laserpick.behaviours.basket_way import BasketWay, drop_postures_for, path_to_a_drop
+from laserpick.behaviours.basket_way import (
+    BasketWay,
+    basket_way,
+    drop_postures_for,
+    path_to_a_drop,
+)
 from laserpick.behaviours.carry import Carrying
 from laserpick.behaviours.drop_postures import past_the_opening
 from laserpick.behaviours.held import Held
@@ -80,7 +85,9 @@ class BasketDrop(Carrying, Stowing):
         or its start was not clear), and the seconds (s) the arm stood still for it."""
         ahead, self.ahead = self.ahead, None
         tolerance = self.settings.behaviour.start_tolerance
-        if ahead is None or not ahead.fits(held, self.current_q(), tolerance):
+        if ahead is None or not ahead.fits(
+            (basket_way, held, held.surroundings), self.current_q(), tolerance
+        ):
             return None, 0.0
         way, waited = ahead.result()
         if way is not None and way.drops:

@@ -3,21 +3,28 @@ on the way (tucked in beside the scooter, raised in front), and the obstacles it
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 
 import numpy as np
 
 from laserpick.behaviours.guarded_motion import GuardedMotion
+from laserpick.behaviours.held import Held
 from laserpick.behaviours.messages import NOT_HOLDING
-from laserpick.behaviours.outcome import SEARCH, Outcome
+from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import timed
+from laserpick.pipeline.plan import joint_path_via, timed
+from laserpick.settings import Settings
 from laserpick.types import Failure
 
-__all__ = ["Carrying", "holding_pose", "without_leftovers"]
+__all__ = ["RAISING", "TUCKING", "Carrying", "holding_pose", "tuck_way", "without_leftovers"]
+
+#: What the tuck's motions do, as the user hears it: to the tucked pose, or raised in front.
+TUCKING = "tucking it in"
+RAISING = "raising"
 
 
 def holding_pose(
@@ -143,24 +150,66 @@ class Carrying(GuardedMotion):
         the user drives and marks where it goes: out of the cameras' view, the laser's way and
         the furniture's (raised in front, the object hangs 1.6 m ahead of the rear axle, into
         a shelf the scooter parks at). Where `tuck_searches` searches find no way there,
-        raised in front (the high ready pose). The outcome's timings give the searches'
-        wall-clock seconds (`CARRY_PLANNING`)."""
+        raised in front (the high ready pose). As searched while the pick lifted the object
+        (`tuck_way`, `ahead`) where the arm stands at that search's start; else searched now,
+        after rising clear. The outcome's timings give the seconds the arm stood still for
+        the searches (`CARRY_PLANNING`)."""
         held = self.held
         if held is None:
             return Outcome(Failure("precondition", NOT_HOLDING))
-        failure = self.rise_clear(held.surroundings, held.points_tcp)
-        if failure is not None:
-            return Outcome(failure)
-        b = self.settings.behaviour
-        high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
-        carry = holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp, b.hold_turns)
-        searched = 0.0
-        for _ in range(b.tuck_searches):
-            out = self.go_to(
-                carry, held.surroundings, "tucking it in", via=(high,), payload=held.points_tcp
-            )
-            searched += out.timings[SEARCH]
-            if out.ok or out.failure is None or out.failure.kind != "ik_plan":
-                return out.planned_for(searched)  # there, or stopped: no second search
-        out = self.go_to(high, held.surroundings, "raising", payload=held.points_tcp)
-        return out.planned_for(searched + out.timings[SEARCH])
+        way, planning = self._tuck_searched_ahead(held)
+        if way is None:
+            failure = self.rise_clear(held.surroundings, held.points_tcp)
+            if failure is not None:
+                return Outcome(failure)
+            t0 = time.perf_counter()
+            way = tuck_way(self.current_q(), held, self.settings, self.rng)
+            planning += time.perf_counter() - t0
+        if way is None:
+            msg = f"No collision-free path was found for {RAISING}."
+            return Outcome(Failure("ik_plan", msg)).planned_for(planning)
+        what, path = way
+        failure = self.follow(path, held.surroundings, what, payload=held.points_tcp)
+        return Outcome(failure).planned_for(planning)
+
+    def _tuck_searched_ahead(self, held: Held) -> tuple[tuple[str, np.ndarray] | None, float]:
+        """The tuck's way searched ahead for `held` from where the arm stands (None: none
+        was, or it found none), and the seconds (s) the arm stood still for it."""
+        ahead, self.ahead = self.ahead, None
+        tolerance = self.settings.behaviour.start_tolerance
+        if ahead is None or not ahead.fits(
+            (tuck_way, held, held.surroundings), self.current_q(), tolerance
+        ):
+            return None, 0.0
+        return ahead.result()
+
+
+def _holding_poses(held: Held, settings: Settings) -> tuple[np.ndarray, np.ndarray]:
+    """The tucked pose and the high ready pose (6,) rad, each with the wrist turned where
+    `held` keeps clear there (`holding_pose`)."""
+    turns = settings.behaviour.hold_turns
+    return (
+        holding_pose(dims.UR5_CARRY_Q, held.surroundings, held.points_tcp, turns),
+        holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, turns),
+    )
+
+
+def tuck_way(
+    q_from: np.ndarray, held: Held, settings: Settings, rng: np.random.Generator
+) -> tuple[str, np.ndarray] | None:
+    """The tuck's way for `held` from q_from (6,) rad, searched with `rng` as `tuck`
+    searches it: what the motion does (`TUCKING` or `RAISING`) and its joint path (K, 6)
+    rad. None where the arm and what it holds are not clear at q_from (the tuck rises clear
+    first) or no search found a way. Reads nothing of the robot: run while the arm lifts."""
+    if not held.surroundings.clearance_ok(q_from, payload=held.points_tcp)[0]:
+        return None
+    carry, high = _holding_poses(held, settings)
+    kw = {"payload": held.points_tcp}
+    for _ in range(settings.behaviour.tuck_searches):
+        path = joint_path_via(
+            q_from, carry, held.surroundings, rng, settings.motion, via=(high,), **kw
+        )
+        if path is not None:
+            return TUCKING, path
+    path = joint_path_via(q_from, high, held.surroundings, rng, settings.motion, **kw)
+    return None if path is None else (RAISING, path)

@@ -12,7 +12,7 @@ import numpy as np
 
 from laserpick.behaviours.ahead import Ahead
 from laserpick.behaviours.basket_way import basket_way
-from laserpick.behaviours.carry import without_leftovers
+from laserpick.behaviours.carry import tuck_way, without_leftovers
 from laserpick.behaviours.drop_postures import holds_over_basket
 from laserpick.behaviours.hand import GRIPPER_TIME, closed_on_something, wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
@@ -39,7 +39,9 @@ class Picking(Withdrawing):
         """Pick with the first grasp of `order` (default: all, in score order) that plans.
         Done, the hand holds the object (`held`), lifted and, from the side, drawn back.
         to_basket: the object goes to the basket next, so a grasp that holds it where no
-        drop posture fits is not taken (`holds_over_basket`)."""
+        drop posture fits is not taken (`holds_over_basket`); else it is tucked in next.
+        While the arm lifts, the way there is searched (`ahead`: `basket_way`, `tuck_way`)
+        from where the lift will leave the arm, for `drop_in_basket` or `tuck` to take up."""
         s = self.settings.motion
         if self.robot.gripper_state().holding:
             return Outcome(Failure("precondition", "The hand is already holding something."))
@@ -60,16 +62,19 @@ class Picking(Withdrawing):
         # the hand has (the object's points travel with it in later collision checks).
         held = self._take_hold(grasps, grasp, plan)
         # Where the lift leaves the arm is known: the way back out of a side grasp, and from
-        # its end the carry to the basket, are searched while the arm lifts.
+        # its end the carry (to the basket, or tucked in), are searched while the arm lifts.
         way_out = self.withdrawal_path(
             grasp.approach, held.surroundings, held.points_tcp, q_from=plan.q_lifted
         )
-        if to_basket:
-            q_from = plan.q_lifted if way_out is None else way_out[-1]
-            rng = np.random.default_rng(self.rng.integers(2**63))  # the thread's own
-            self.ahead = Ahead(
-                self.robot, q_from, held, lambda: basket_way(q_from, held, self.settings, rng)
-            )
+        q_from = plan.q_lifted if way_out is None else way_out[-1]
+        rng = np.random.default_rng(self.rng.integers(2**63))  # the thread's own
+        carry = basket_way if to_basket else tuck_way
+        # Taken up for this carry only, of this object among these surroundings (replaced
+        # where the scooter has moved).
+        owners = (carry, held, held.surroundings)
+        self.ahead = Ahead(
+            self.robot, q_from, owners, lambda: carry(q_from, held, self.settings, rng)
+        )
         self.progress("Lifting the object.")
         failure, closed = self._regrip_and_lift(plan)
         if failure:
