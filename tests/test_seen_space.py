@@ -162,6 +162,43 @@ def test_from_standing_by_to_a_grasp_on_the_other_elbow_branch_the_elbow_turns_o
         assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
 
 
+def test_from_the_stowed_pose_under_a_board_the_elbow_turns_on_the_way_to_the_exit(world):
+    """From the stowed pose (elbow down), where a board fills both ready poses, a pre-grasp
+    with the elbow up is reached through the unstow pose and standing by's exit: the elbow
+    turns over on the straight way between them, beside the scooter, and the leg held to
+    seen space starts at the exit, on the pre-grasp's branch. A pre-grasp with the elbow
+    down goes on from the unstow pose, as before."""
+    s = get_settings().motion
+    exit_ = dims.UR5_STANDBY_EXIT_Q
+    board = CollisionChecker(table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0)), filtered=True)
+    via = (READY, dims.UR5_HIGH_READY_Q)
+    assert not board.clearance_ok(np.array(via)).any()
+    up = _hand_at(1.55, -0.20, 0.65)
+    T = tcp_pose(READY)
+    T[:3, 3] = 1.40, -0.45, 0.75
+    down = ik_tcp(T, UNSTOW)[0]
+    assert up[2] > 0 > down[2]
+    for q_pre, passes in ((up, [HOME, UNSTOW, exit_]), (down, [HOME, UNSTOW])):
+        route = transit_path(
+            HOME,
+            q_pre,
+            board,
+            np.random.default_rng(0),
+            s,
+            Searches(6),
+            via,
+            UNSTOW,
+            turn=exit_,
+        )
+        assert route is not None
+        at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
+        pairs = zip(at, passes, strict=True)
+        assert all(np.allclose(route[0][k], q) for k, q in pairs), "passes them"
+        assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
+        if q_pre is down:
+            assert not np.isclose(route[0], exit_).all(axis=1).any()
+
+
 def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
     """From the ready pose to a hand beside the table's right edge: the path found keeps
     the hand out of the blind space beside the scooter at every step between. The ends may

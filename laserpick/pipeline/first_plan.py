@@ -94,7 +94,7 @@ def plan_first(
             searches=searches,
             unstow=UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
             standby=standby,
-            turn=UR5_UNSTOW_Q if standby else None,
+            turn=UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
             payload=grasp.in_hand(carried),
         )
         if not isinstance(plan, Failure):

@@ -308,14 +308,20 @@ def _way_out(
     None when q_now is not a rest pose, or its way out is not clear in the `world`.
 
     From the stowed pose (`unstow` given, `UR5_UNSTOW_Q`): through the unstow pose, then the
-    first `clear` ready pose, where the elbow turns over. From standing by (`standby`), the
+    first `clear` ready pose, where the elbow turns over; where none is clear (a shelf's
+    boards fill both), for a pre-grasp on the other elbow branch, on to `turn` (standing
+    by's exit, `UR5_STANDBY_EXIT_Q`), the elbow up. From standing by (`standby`), the
     elbow up: to the first clear ready pose, else through `unstow`, its exit
     (`UR5_STANDBY_EXIT_Q`); for a pre-grasp on the other elbow branch, on to `turn` (the
-    unstow pose) as the stow goes, so that the elbow turns over on the way out, not on the
-    leg held to seen space."""
+    unstow pose) as the stow goes. Either way the elbow turns over on the way out, not on
+    the leg held to seen space: turned there, the hand swings through space no camera saw,
+    and each grasp's search spent all its samples (a pill bottle on the bookshelf, 16 s)."""
     if not standby:
-        ok = unstow is not None and world.clearance_ok(unstow)[0]
-        return [unstow, *clear[:1]] if ok else None
+        if unstow is None or not world.clearance_ok(unstow)[0]:
+            return None
+        if not clear and turn is not None and q_pre[2] * unstow[2] < 0:
+            return [unstow, turn] if world.clearance_ok(turn)[0] else [unstow]
+        return [unstow, *clear[:1]]
     if turn is not None and q_pre[2] * q_now[2] < 0 and world.clearance_ok(turn)[0]:
         return [*clear[:1], turn]
     if clear:
@@ -351,8 +357,9 @@ def plan_pick(
     the scooter, where no camera sees).
     standby: the arm stands by between picks (`UR5_STANDBY_Q`): its way to a ready pose is
     fixed too, beside the scooter; `unstow` is then its exit, taken only where no ready
-    pose is clear (`transit_path`); `turn`, where the way from standing by ends for a
-    grasp on the other elbow branch (`UR5_UNSTOW_Q`).
+    pose is clear (`transit_path`). turn: where the way out ends for a grasp on the other
+    elbow branch: from standing by, `UR5_UNSTOW_Q`; from the stowed pose where no ready
+    pose is clear, `UR5_STANDBY_EXIT_Q` (`_way_out`).
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
