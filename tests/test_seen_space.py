@@ -127,39 +127,43 @@ def test_from_standing_by_under_a_board_the_way_out_passes_its_exit(world):
         np.testing.assert_allclose(route[0][:2], passes)
 
 
+def _route_passes(
+    q_now: np.ndarray,
+    q_pre: np.ndarray,
+    checker: CollisionChecker,
+    passes: list[np.ndarray],
+    unstow: np.ndarray,
+    standby: bool = False,
+    turn: np.ndarray | None = None,
+) -> np.ndarray:
+    """The transit from q_now to q_pre (`transit_path`, through the ready poses where clear),
+    asserted to pass through each of `passes` in order, then on to q_pre; its waypoints."""
+    via = (READY, dims.UR5_HIGH_READY_Q)
+    rng, s = np.random.default_rng(0), get_settings().motion
+    route = transit_path(q_now, q_pre, checker, rng, s, Searches(6), via, unstow, standby, turn)
+    assert route is not None
+    at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
+    pairs = zip(at, passes, strict=True)
+    assert all(np.allclose(route[0][k], q) for k, q in pairs), "passes them"
+    assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
+    return route[0]
+
+
 def test_from_standing_by_to_a_grasp_on_the_other_elbow_branch_the_elbow_turns_on_the_way_out(
     world,
 ):
     """A pre-grasp on the stowed pose's elbow branch (elbow down): from standing by (elbow
     up) the way out ends at the unstow pose, through a ready pose where one is clear, as the
     stow goes, so that the elbow turns over there and not on the leg held to seen space."""
-    s = get_settings().motion
     standby = dims.UR5_STANDBY_Q
     T = tcp_pose(READY)
     T[:3, 3] = 1.40, -0.45, 0.75
     q_pre = ik_tcp(T, UNSTOW)[0]
     assert q_pre[2] < 0, "elbow down"
-    via = (READY, dims.UR5_HIGH_READY_Q)
     board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
     for points, passes in ((world.points, [standby, READY, UNSTOW]), (board, [standby, UNSTOW])):
         checker = CollisionChecker(points, filtered=True)
-        route = transit_path(
-            standby,
-            q_pre,
-            checker,
-            np.random.default_rng(0),
-            s,
-            Searches(6),
-            via,
-            dims.UR5_STANDBY_EXIT_Q,
-            True,
-            UNSTOW,
-        )
-        assert route is not None
-        at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
-        pairs = zip(at, passes, strict=True)
-        assert all(np.allclose(route[0][k], q) for k, q in pairs), "passes them"
-        assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
+        _route_passes(standby, q_pre, checker, passes, dims.UR5_STANDBY_EXIT_Q, True, UNSTOW)
 
 
 def test_from_the_stowed_pose_under_a_board_the_elbow_turns_on_the_way_to_the_exit(world):
@@ -168,35 +172,18 @@ def test_from_the_stowed_pose_under_a_board_the_elbow_turns_on_the_way_to_the_ex
     turns over on the straight way between them, beside the scooter, and the leg held to
     seen space starts at the exit, on the pre-grasp's branch. A pre-grasp with the elbow
     down goes on from the unstow pose, as before."""
-    s = get_settings().motion
     exit_ = dims.UR5_STANDBY_EXIT_Q
     board = CollisionChecker(table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0)), filtered=True)
-    via = (READY, dims.UR5_HIGH_READY_Q)
-    assert not board.clearance_ok(np.array(via)).any()
+    assert not board.clearance_ok(np.array([READY, dims.UR5_HIGH_READY_Q])).any()
     up = _hand_at(1.55, -0.20, 0.65)
     T = tcp_pose(READY)
     T[:3, 3] = 1.40, -0.45, 0.75
     down = ik_tcp(T, UNSTOW)[0]
     assert up[2] > 0 > down[2]
     for q_pre, passes in ((up, [HOME, UNSTOW, exit_]), (down, [HOME, UNSTOW])):
-        route = transit_path(
-            HOME,
-            q_pre,
-            board,
-            np.random.default_rng(0),
-            s,
-            Searches(6),
-            via,
-            UNSTOW,
-            turn=exit_,
-        )
-        assert route is not None
-        at = [int(np.argmin(np.abs(route[0] - q).max(axis=1))) for q in passes]
-        pairs = zip(at, passes, strict=True)
-        assert all(np.allclose(route[0][k], q) for k, q in pairs), "passes them"
-        assert at == sorted(at) and np.allclose(route[0][-1], q_pre), "in order, then on"
+        route = _route_passes(HOME, q_pre, board, passes, UNSTOW, turn=exit_)
         if q_pre is down:
-            assert not np.isclose(route[0], exit_).all(axis=1).any()
+            assert not np.isclose(route, exit_).all(axis=1).any()
 
 
 def test_a_planned_transit_keeps_the_hand_in_seen_space(world):
