@@ -61,20 +61,7 @@ class Picking(Withdrawing):
         # Held from here on, so that a cancel or an e-stop while lifting still knows what
         # the hand has (the object's points travel with it in later collision checks).
         held = self._take_hold(grasps, grasp, plan)
-        # Where the lift leaves the arm is known: the way back out of a side grasp, and from
-        # its end the carry (to the basket, or tucked in), are searched while the arm lifts.
-        way_out = self.withdrawal_path(
-            grasp.approach, held.surroundings, held.points_tcp, q_from=plan.q_lifted
-        )
-        q_from = plan.q_lifted if way_out is None else way_out[-1]
-        rng = np.random.default_rng(self.rng.integers(2**63))  # the thread's own
-        carry = basket_way if to_basket else tuck_way
-        # Taken up for this carry only, of this object among these surroundings (replaced
-        # where the scooter has moved).
-        owners = (carry, held, held.surroundings)
-        self.ahead = Ahead(
-            self.robot, q_from, owners, lambda: carry(q_from, held, self.settings, rng)
-        )
+        way_out = self._search_ahead(held, plan, to_basket)
         self.progress("Lifting the object.")
         failure, closed = self._regrip_and_lift(plan)
         if failure:
@@ -86,6 +73,26 @@ class Picking(Withdrawing):
             return Outcome(failure, grasp, attempts, timings, closed_width=closed)
         self.progress("Holding the object.")
         return Outcome(None, grasp, attempts, timings, closed_width=closed)
+
+    def _search_ahead(self, held: Held, plan: PickPlan, to_basket: bool) -> np.ndarray | None:
+        """Start the search for the carry of `held` that follows the pick (`ahead`: to the
+        basket, `basket_way`, or tucked in, `tuck_way`), from where the lift will leave the
+        arm: the planned lifted posture, or after a grasp from the side, the end of the way
+        back out of it, found from there. Returns that way (N, 6) rad, None from above."""
+        approach = held.grasp.approach
+        way_out = self.withdrawal_path(
+            approach, held.surroundings, held.points_tcp, q_from=plan.q_lifted
+        )
+        q_from = plan.q_lifted if way_out is None else way_out[-1]
+        rng = np.random.default_rng(self.rng.integers(2**63))  # the thread's own
+        carry = basket_way if to_basket else tuck_way
+        # Taken up for this carry only, of this object among these surroundings (replaced
+        # where the scooter has moved).
+        owners = (carry, held, held.surroundings)
+        self.ahead = Ahead(
+            self.robot, q_from, owners, lambda: carry(q_from, held, self.settings, rng)
+        )
+        return way_out
 
     def _basket_admits(self, grasps: GraspSet) -> Callable[[Grasp], Failure | None]:
         """For `plan_first`: refuses a grasp that holds the object, as carried and as it
