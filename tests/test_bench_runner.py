@@ -109,8 +109,8 @@ def test_a_run_replays_the_same_in_workers_and_on_ray() -> None:
         if r["failure"] not in ("detect_laser", "precondition", "detect_grasp"):
             assert r["timings"]["plan"] > 0
             assert r["timings"]["attempt_total"] >= r["timings"]["plan"]
-        if r["success"]:  # planned the way to the basket with the object in the hand
-            assert r["timings"]["plan_carry"] > 0
+        if r["success"]:  # the wait for the way to the basket, the object in the hand:
+            assert r["timings"]["plan_carry"] >= 0  # none where found while it lifted
         if r["grasped"]:  # a lifted object: the width planned and the gap closed to, in m
             planned, closed = r["grip"]
             assert 0 < planned <= dims.GRIPPER_STROKE and closed > dims.GRIPPER_EMPTY_GAP
