@@ -26,8 +26,8 @@ T = TypeVar("T")
 
 class Ahead(Generic[T]):
     """One search running ahead of the arm, for the motion that starts at `start` (6,) rad,
-    searched for `owners` (the objects it read: the held object and its surroundings; a use
-    where any of them was replaced is refused)."""
+    searched for `owners` (the search function and what it read: the held object and its
+    surroundings; a use where any of them differs is refused)."""
 
     def __init__(
         self, robot: Robot, start: np.ndarray, owners: tuple[object, ...], search: Callable[[], T]
