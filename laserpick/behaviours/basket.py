@@ -83,13 +83,7 @@ class BasketDrop(Carrying, Stowing):
     def _way_searched_ahead(self, held: Held) -> tuple[BasketWay | None, float]:
         """The carry searched ahead for `held` from where the arm stands (None: none was,
         or its start was not clear), and the seconds (s) the arm stood still for it."""
-        ahead, self.ahead = self.ahead, None
-        tolerance = self.settings.behaviour.start_tolerance
-        if ahead is None or not ahead.fits(
-            (basket_way, held, held.surroundings), self.current_q(), tolerance
-        ):
-            return None, 0.0
-        way, waited = ahead.result()
+        way, waited = self.searched_ahead(basket_way, held)
         if way is not None and way.drops:
             self.progress(CARRYING)
         return way, waited

@@ -157,7 +157,7 @@ class Carrying(GuardedMotion):
         held = self.held
         if held is None:
             return Outcome(Failure("precondition", NOT_HOLDING))
-        way, planning = self._tuck_searched_ahead(held)
+        way, planning = self.searched_ahead(tuck_way, held)
         if way is None:
             failure = self.rise_clear(held.surroundings, held.points_tcp)
             if failure is not None:
@@ -171,17 +171,6 @@ class Carrying(GuardedMotion):
         what, path = way
         failure = self.follow(path, held.surroundings, what, payload=held.points_tcp)
         return Outcome(failure).planned_for(planning)
-
-    def _tuck_searched_ahead(self, held: Held) -> tuple[tuple[str, np.ndarray] | None, float]:
-        """The tuck's way searched ahead for `held` from where the arm stands (None: none
-        was, or it found none), and the seconds (s) the arm stood still for it."""
-        ahead, self.ahead = self.ahead, None
-        tolerance = self.settings.behaviour.start_tolerance
-        if ahead is None or not ahead.fits(
-            (tuck_way, held, held.surroundings), self.current_q(), tolerance
-        ):
-            return None, 0.0
-        return ahead.result()
 
 
 def _holding_poses(held: Held, settings: Settings) -> tuple[np.ndarray, np.ndarray]:

@@ -11,6 +11,7 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -126,6 +127,18 @@ class GuardedMotion:
         way_back = timed(path, s, joint_speed=s.joint_speed_for(carrying=self.held is not None))
         handle = self.robot.execute(way_back)
         return self.robot.wait(handle, way_back.duration + b.motion_slack) == "done"
+
+    def searched_ahead(self, search: Callable, held: Held) -> tuple[Any, float]:
+        """What the search ahead (`ahead`) found, where it was `search` for `held` among its
+        surroundings and the arm stands at its start; else None. With the seconds (s) the
+        arm stood still for it (`Ahead.result`). Taken either way: `ahead` is None after."""
+        ahead, self.ahead = self.ahead, None
+        tolerance = self.settings.behaviour.start_tolerance
+        if ahead is None or not ahead.fits(
+            (search, held, held.surroundings), self.current_q(), tolerance
+        ):
+            return None, 0.0
+        return ahead.result()
 
     def go_to(
         self,
