@@ -21,6 +21,7 @@ from laserpick.bench.compare import (
     format_comparison,
     load_result,
 )
+from laserpick.bench.results import environment
 
 
 def _record(trial: int, task: int, instance: str, **fields: Any) -> dict[str, Any]:
@@ -139,6 +140,28 @@ def test_another_cpu_model_is_noted(old: dict[str, Any]) -> None:
     notes = compare_results(a, b).notes
     assert any(n.startswith("CPU differs: AMD EPYC -> Intel") for n in notes), notes
     assert compare_results(a, copy.deepcopy(a)).notes == ()
+
+
+def test_other_settings_are_noted(old: dict[str, Any]) -> None:
+    """A run with a setting overridden makes other attempts: a comparison says which, and
+    a result written before settings were recorded notes none."""
+    quick = {"LASERPICK_MOTION__QUICKEN_PATHS": "true"}
+    a = copy.deepcopy(old) | {"environment": {"settings": {}}}
+    b = copy.deepcopy(old) | {"environment": {"settings": quick}}
+    assert compare_results(a, b).notes == (
+        "setting LASERPICK_MOTION__QUICKEN_PATHS differs: unset -> true",
+    )
+    assert compare_results(old, b).notes == ()
+
+
+def test_a_result_records_the_settings_the_environment_overrode(monkeypatch) -> None:
+    """The run's `LASERPICK_*` variables, a secret's name without its value."""
+    monkeypatch.setenv("LASERPICK_MOTION__QUICKEN_PATHS", "true")
+    monkeypatch.setenv("LASERPICK_OPERATOR_PASSWORD", "hunter2")
+    recorded = environment()["settings"]
+    assert recorded["LASERPICK_MOTION__QUICKEN_PATHS"] == "true"
+    assert recorded["LASERPICK_OPERATOR_PASSWORD"] == "(set)"
+    assert "hunter2" not in json.dumps(recorded)
 
 
 def test_other_commits_are_noted_not_counted_as_differences(old: dict[str, Any]) -> None:

@@ -204,6 +204,13 @@ def _run_notes(old: Mapping[str, Any], new: Mapping[str, Any]) -> list[str]:
     for name in sorted(set(old_pkg) & set(new_pkg)):
         if old_pkg[name] != new_pkg[name]:
             notes.append(f"package {name} differs: {old_pkg[name]} -> {new_pkg[name]}")
+    old_set = (old.get("environment") or {}).get("settings")
+    new_set = (new.get("environment") or {}).get("settings")
+    if old_set is not None and new_set is not None:
+        for name in sorted(set(old_set) | set(new_set)):
+            if old_set.get(name) != new_set.get(name):
+                was, now = old_set.get(name, "unset"), new_set.get(name, "unset")
+                notes.append(f"setting {name} differs: {was} -> {now}")
     # Floating point differs in its last digits between CPU models: a grip a millimetre off
     # sends a trial elsewhere, so attempts repeat on one machine only.
     cpus = [(r.get("environment") or {}).get("cpu") for r in (old, new)]

@@ -11,6 +11,7 @@ Rates (0-1):
 
 from __future__ import annotations
 
+import os
 import platform
 import statistics
 import subprocess
@@ -71,16 +72,39 @@ def source_revision(root: Path | None = None) -> dict[str, Any]:
     return {"commit": commit, "tree_clean": None if changes is None else changes == ""}
 
 
+#: Parts of a setting's name that mark it secret: a result names it, not its value.
+SECRET_WORDS = ("PASSWORD", "TOKEN", "SECRET", "KEY")
+
+
 def environment() -> dict[str, Any]:
     """What a run's outcomes depend on besides the code and the seed: Python's version, each
-    of RESULT_PACKAGES' installed versions (None when missing) and the CPU's model name."""
+    of RESULT_PACKAGES' installed versions (None when missing), the CPU's model name and
+    the settings the environment overrode (`settings_overrides`)."""
     packages: dict[str, str | None] = {}
     for name in RESULT_PACKAGES:
         try:
             packages[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             packages[name] = None
-    return {"python": platform.python_version(), "packages": packages, "cpu": _cpu_model()}
+    return {
+        "python": platform.python_version(),
+        "packages": packages,
+        "cpu": _cpu_model(),
+        "settings": settings_overrides(),
+    }
+
+
+def settings_overrides() -> dict[str, str]:
+    """The `LASERPICK_*` environment variables set for this run, by name, but those that
+    hold secrets (a password, a token), which are named with their value left out: a run
+    with the partial shortcuts on (`LASERPICK_MOTION__QUICKEN_PATHS=true`) makes other
+    attempts than one without."""
+    out = {}
+    for name, value in sorted(os.environ.items()):
+        if name.upper().startswith("LASERPICK_"):
+            secret = any(word in name.upper() for word in SECRET_WORDS)
+            out[name] = "(set)" if secret else value
+    return out
 
 
 def _cpu_model() -> str:

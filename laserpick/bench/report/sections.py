@@ -41,6 +41,10 @@ def _header(result: dict[str, Any], ref: Reference) -> list[str]:
     if env:  # runs before the record was kept have none
         packages = ", ".join(f"{k} {v}" for k, v in env["packages"].items() if v)
         lines += ["", f"Python {env['python']}; {packages}; CPU: {env['cpu']}."]
+        overrides = env.get("settings")
+        if overrides is not None:
+            said = ", ".join(f"`{k}={v}`" for k, v in overrides.items()) or "none"
+            lines += ["", f"Settings overridden by the environment: {said}."]
     for error in result.get("errors") or []:
         lines += [
             "",
