@@ -231,3 +231,32 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
         assert above[2, 3] - drop - 0.003 < end[2] < above[2, 3] + 0.003
     finally:
         robot.close()
+
+
+def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises():
+    """`free_the_pads`, which the basket's drop runs before the open hand rises (there, a
+    spray bottle wedged against a pad was lifted out with it): an open hand whose pads feel
+    nothing does not move; one whose pad presses a rail is lowered and eased off it, and
+    its pads then feel nothing."""
+    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        b = Behaviours(robot)
+        s = b.settings.motion
+        hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
+        moves = recorded_moves(b)
+        assert b.free_the_pads() is False and moves == []
+        straddling = top_down(1.60, -0.30, RAIL_TOP - 0.01)
+        down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
+        assert down is not None and b.run(timed(down, s, tcp_speed=0.05), "test") is None
+        pressed = top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
+        across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
+        assert across is not None and b.run(timed(across, s, tcp_speed=0.02), "test") is None
+        assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+        moves.clear()
+        assert b.free_the_pads() is True
+        assert moves[0] == "freeing the fingers" and "easing the pads off" in moves
+        robot.sleep(BEHAVIOUR.leave_settle)
+        assert robot.gripper_state().force <= BEHAVIOUR.pads_clear
+    finally:
+        robot.close()

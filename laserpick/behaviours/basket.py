@@ -17,6 +17,7 @@ from laserpick.behaviours.basket_way import (
 from laserpick.behaviours.carry import Carrying
 from laserpick.behaviours.drop_postures import past_the_opening
 from laserpick.behaviours.held import Held
+from laserpick.behaviours.leave import Leaving
 from laserpick.behaviours.messages import NOT_HOLDING, PAST_THE_OPENING
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.stow import Stowing
@@ -31,7 +32,7 @@ __all__ = ["BasketDrop"]
 CARRYING = "Carrying the object to the basket."
 
 
-class BasketDrop(Carrying, Stowing):
+class BasketDrop(Carrying, Leaving, Stowing):
     """The drop in the basket (`drop_in_basket`)."""
 
     def drop_in_basket(self) -> Outcome:
@@ -108,15 +109,17 @@ class BasketDrop(Carrying, Stowing):
     def _leave_basket(self, held: Held, let_go: np.ndarray) -> Outcome:
         """From over the basket, the open hand rises off the object (`let_go`, m, `base`)
         before it turns away: a tall bottle stands up out of the basket, and a straight way
-        to ready sweeps the fingers through it. Then to ready around the object as it was
-        let go, else as it fell, lower (no way around it); where a shelf's or a high
-        table's boards fill both ready poses, folded away from the basket instead, as the
-        session's stow would do next."""
+        to ready sweeps the fingers through it. Where its pads still press the object, they
+        are freed first (`free_the_pads`): risen, the hand would lift it out. Then to ready
+        around the object as it was let go, else as it fell, lower (no way around it); where
+        a shelf's or a high table's boards fill both ready poses, folded away from the
+        basket instead, as the session's stow would do next."""
         around = CollisionChecker(
             np.vstack([held.surroundings.points, let_go]),
             margin=self.settings.motion.clearance,
             filtered=True,
         )
+        self.free_the_pads()
         failure = self.rise_clear(around, hand_on_the_way=held.surroundings)
         if failure is not None:
             return Outcome(failure)
