@@ -190,6 +190,20 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         robot.close()
 
 
+def _press_a_pad_on_the_rail(b: Behaviours) -> None:
+    """From above the rail, lower the open hand to straddle it, then move it sideways 12.5
+    mm past where a pad meets the rail: the finger gives, and presses it (less and less as
+    it goes on giving: read at once)."""
+    robot, s = b.robot, b.settings.motion
+    straddling = top_down(1.60, -0.30, RAIL_TOP - 0.01)
+    down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
+    assert down is not None and b.run(timed(down, s, tcp_speed=0.05), "test") is None
+    pressed = top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
+    across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
+    assert across is not None and b.run(timed(across, s, tcp_speed=0.02), "test") is None
+    assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+
+
 def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leaves():
     """Opened, a finger can still press a mug it dragged by its handle (8.9 N), and drawn
     straight up, lift the mug 9 cm by the handle's top bar; lowered first, it comes
@@ -203,16 +217,7 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
         moves = recorded_moves(b)
         free = CollisionChecker(np.zeros((0, 3)))
         hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
-        s = b.settings.motion
-        straddling = top_down(1.60, -0.30, RAIL_TOP - 0.01)
-        down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
-        assert down is not None and b.run(timed(down, s, tcp_speed=0.05), "test") is None
-        # Sideways, 12.5 mm past where a pad meets the rail: the finger gives, and presses
-        # it (less and less as it goes on giving: read at once).
-        pressed = top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
-        across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
-        assert across is not None and b.run(timed(across, s, tcp_speed=0.02), "test") is None
-        assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+        _press_a_pad_on_the_rail(b)
         start = tcp_pose(robot.joint_state().q)
         above = start.copy()
         above[2, 3] += 0.10
@@ -242,17 +247,10 @@ def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises
     try:
         robot.sim.settle(0.5)
         b = Behaviours(robot)
-        s = b.settings.motion
         hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
         moves = recorded_moves(b)
         assert b.free_the_pads() is False and moves == []
-        straddling = top_down(1.60, -0.30, RAIL_TOP - 0.01)
-        down = cartesian_line(robot.joint_state().q, straddling, s.cartesian_step)
-        assert down is not None and b.run(timed(down, s, tcp_speed=0.05), "test") is None
-        pressed = top_down(1.60, -0.30 + 0.04, RAIL_TOP - 0.01)
-        across = cartesian_line(robot.joint_state().q, pressed, s.cartesian_step / 5)
-        assert across is not None and b.run(timed(across, s, tcp_speed=0.02), "test") is None
-        assert robot.gripper_state().force > dims.GRIPPER_HOLD_FORCE, "a pad presses the rail"
+        _press_a_pad_on_the_rail(b)
         moves.clear()
         assert b.free_the_pads() is True
         assert moves[0] == "freeing the fingers" and "easing the pads off" in moves
