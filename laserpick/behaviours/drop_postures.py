@@ -32,11 +32,6 @@ __all__ = [
 DropRank = tuple[int, int, int, int, float]
 #: Postures checked at once: the check's arrays grow with postures x payload points x spheres.
 CHUNK = 64
-#: The cell (m) of the coarse payload a posture is checked with first, one point of the held
-#: object in each. A posture that does not clear those points cannot clear them all, so only
-#: the postures it clears are checked again with every point: the same verdict, sooner where
-#: most postures fail, as they do for a long box held near its end.
-COARSE_PAYLOAD = 0.05
 #: Configurations along the straight joint move whose TCP arc `reach_times` sums.
 REACH_SAMPLES = 16
 
@@ -177,26 +172,12 @@ def _posture_families(
 
 def clear_carrying(checker: CollisionChecker, Q: np.ndarray, payload: np.ndarray) -> np.ndarray:
     """(B,) bool: `checker.clearance_ok` of configurations Q (B, 6) (rad) carrying `payload`
-    (P, 3), TCP frame (m), asked in chunks of CHUNK, first of one payload point per
-    COARSE_PAYLOAD cell and then of all the points where that passed. Exact: a
-    configuration clear with all the points is clear with any of them."""
-    coarse = _one_per_cell(payload, COARSE_PAYLOAD)
+    (P, 3), TCP frame (m), asked in chunks of CHUNK (the check's arrays grow with
+    configurations x payload points x spheres)."""
     out = np.zeros(len(Q), bool)
     for i in range(0, len(Q), CHUNK):
-        part = Q[i : i + CHUNK]
-        ok = checker.clearance_ok(part, payload=coarse)
-        if len(coarse) < len(payload) and ok.any():
-            ok[ok] = checker.clearance_ok(part[ok], payload=payload)
-        out[i : i + CHUNK] = ok
+        out[i : i + CHUNK] = checker.clearance_ok(Q[i : i + CHUNK], payload=payload)
     return out
-
-
-def _one_per_cell(points: np.ndarray, cell: float) -> np.ndarray:
-    """The first of `points` (P, 3) (m) in each cube of side `cell` (m)."""
-    if len(points) == 0:
-        return points
-    _, first = np.unique(np.floor(points / cell).astype(np.int64), axis=0, return_index=True)
-    return points[np.sort(first)]
 
 
 def basket_opening() -> tuple[np.ndarray, np.ndarray]:

@@ -25,6 +25,20 @@ CARRIED_VOXEL = 0.02
 CARRIED_TOP_BAND = 0.02
 #: Points this close (m) to a held object's points are taken to be the object itself.
 CARRIED_PADDING = 0.03
+#: The cell (m) of the coarse payload a configuration is checked with first, one point of
+#: the held object in each (`coarse_payload`).
+COARSE_PAYLOAD = 0.05
+
+
+def coarse_payload(payload: np.ndarray) -> np.ndarray:
+    """The first of a held object's points `payload` (P, 3) (m) in each cube of side
+    COARSE_PAYLOAD: a configuration that does not clear these cannot clear them all, so
+    checked first, they reject most blocked configurations at a fraction of the work."""
+    if len(payload) == 0:
+        return payload
+    cells = np.floor(payload / COARSE_PAYLOAD).astype(np.int64)
+    _, first = np.unique(cells, axis=0, return_index=True)
+    return payload[np.sort(first)]
 
 
 def held_points(frames: np.ndarray, payload: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from laserpick.pipeline.collision.arm_spheres import HAND_BODY, SPHERES, sphere_
 from laserpick.pipeline.collision.broad_phase import Ball, balls
 from laserpick.pipeline.collision.carried import (
     PAYLOAD_POINT_RADIUS,
+    coarse_payload,
     held_points,
     off_upper_links,
 )
@@ -68,6 +69,8 @@ class CollisionChecker:
         stood = q_self is not None and bool(self.frames)
         own = sphere_centres(body_frames(q_self))[0] if stood else np.zeros((0, 3))
         self._own = OwnSpace(own, SPHERES.radius[: len(own)] + OWN_SPACE_PADDING)
+        #: the last held object asked about, and its coarse points (`_coarse_of`)
+        self._coarse: tuple[np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def world_and_surroundings(
@@ -114,6 +117,37 @@ class CollisionChecker:
         """
         margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
+        if payload is None or len(payload) == 0:
+            return self._clear(Q, hand, None, margin, seen)
+        coarse = self._coarse_of(payload)
+        if len(coarse) == len(payload):
+            return self._clear(Q, hand, payload, margin, seen)
+        # Exact: what does not clear some of the object's points does not clear them all.
+        clear = self._clear(Q, hand, coarse, margin, seen=False)
+        rows = np.flatnonzero(clear)
+        if len(rows):
+            clear[rows] = self._clear(Q[rows], hand, payload, margin, seen)
+        return clear
+
+    def _coarse_of(self, payload: np.ndarray) -> np.ndarray:
+        """`coarse_payload` of `payload`, kept for the next call: a search asks about the
+        same held object thousands of times."""
+        last = self._coarse
+        if last is not None and last[0] is payload:
+            return last[1]
+        coarse = coarse_payload(payload)
+        self._coarse = (payload, coarse)
+        return coarse
+
+    def _clear(
+        self,
+        Q: np.ndarray,
+        hand: bool,
+        payload: np.ndarray | None,
+        margin: float,
+        seen: bool,
+    ) -> np.ndarray:
+        """`clearance_ok` of configurations Q (B, 6) (rad) with every point of `payload`."""
         frames = body_frames(Q)
         spheres = sphere_centres(frames)
         centres, radius, body = spheres, SPHERES.radius, SPHERES.body
