@@ -91,6 +91,23 @@ def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
     return float(math.acos(max(-1.0, min(1.0, c))))
 
 
+def turn_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rotation (3, 3) taking unit vector `a` onto unit vector `b` the shortest way
+    (Rodrigues); half a turn about an axis across `a` where they point opposite ways."""
+    axis = np.cross(a, b)
+    s, c = float(np.linalg.norm(axis)), float(a @ b)
+    if s < 1e-12:
+        if c > 0:
+            return np.eye(3)
+        e = np.eye(3)[int(np.argmin(np.abs(a)))]
+        k = e - (e @ a) * a
+        k /= np.linalg.norm(k)
+        return 2.0 * np.outer(k, k) - np.eye(3)
+    k = axis / s
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
 def pinhole_intrinsics(width: int, height: int, fovy: float) -> np.ndarray:
     """K (3x3, px) of a MuJoCo-style camera with vertical field of view `fovy` (rad).
 

@@ -59,7 +59,7 @@ def past_and_fall(q: np.ndarray, payload: np.ndarray) -> tuple[int, float]:
     T = tcp_pose(q)
     held = payload @ T[:3, :3].T + T[:3, 3]
     past = float(np.maximum(np.maximum(lo - held[:, :2], held[:, :2] - hi), 0.0).max())
-    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    floor = dims.BASKET_FLOOR
     return math.ceil(past / BEHAVIOUR.overhang_step - 1e-9), float(held[:, 2].min() - floor)
 
 

@@ -26,6 +26,7 @@ from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.plan import timed
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
+from laserpick.transforms import rotx
 from laserpick.types import Failure, Trajectory
 
 
@@ -256,5 +257,45 @@ def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises
         assert moves[0] == "freeing the fingers" and "easing the pads off" in moves
         robot.sleep(BEHAVIOUR.leave_settle)
         assert robot.gripper_state().force <= BEHAVIOUR.pads_clear
+    finally:
+        robot.close()
+
+
+def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back():
+    """What hangs from a tilted pad's edge goes with the pad as it is eased sideways (over
+    the basket, a pill bottle by its cap's lip, `test_parking_advice`); so pads that still
+    press then have the open hand turn about its TCP to point straight down, and back to
+    where it let go. The rail scene cannot hang an object from a pad: here the pads read
+    pressed while the hand tilts more than 5 deg."""
+    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        b = Behaviours(robot)
+        tilted = top_down(1.30, 0.0, RAIL_TOP + 0.20)
+        tilted[:3, :3] = rotx(np.radians(30)) @ tilted[:3, :3]
+        hand_at(b, tilted)
+
+        def tilt() -> float:
+            return float(np.degrees(np.arccos(-tcp_pose(robot.joint_state().q)[2, 2])))
+
+        b._pads_still_pressed = lambda: tilt() > 5.0  # type: ignore[method-assign]
+        tilts: list[float] = []
+        run = b.run
+
+        def record(traj: Trajectory, what: str) -> Failure | None:
+            failure = run(traj, what)
+            if what == "tipping it off":
+                tilts.append(tilt())
+            return failure
+
+        b.run = record  # type: ignore[method-assign]
+        let_go = tcp_pose(robot.joint_state().q)
+        assert b.free_the_pads() is True
+        assert len(tilts) == 2 and tilts[0] < 1.0, "turned upright"
+        end = tcp_pose(robot.joint_state().q)
+        assert abs(tilts[1] - 30.0) < 1.0, "and back"
+        np.testing.assert_allclose(end[:3, :3], let_go[:3, :3], atol=0.02)
+        # Only lowered (`leave_drop`) and eased sideways (`leave_shift`) before the turns.
+        assert np.linalg.norm(end[:3, 3] - let_go[:3, 3]) < 0.04
     finally:
         robot.close()

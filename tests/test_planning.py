@@ -21,7 +21,7 @@ from laserpick.pipeline.collision import (
     held_clear_of_arm,
     sphere_centres,
 )
-from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.lines import TURN_STEP, cartesian_line
 from laserpick.pipeline.plan import (
     Searches,
     joint_path,
@@ -33,6 +33,7 @@ from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut
 from laserpick.settings import MotionSettings, get_settings
+from laserpick.transforms import rotation_angle, rotx
 from laserpick.types import Failure, Grasp
 
 
@@ -115,6 +116,22 @@ def test_cartesian_line_is_straight():
     off = (p - T0[:3, 3]) - np.outer((p - T0[:3, 3]) @ d, d)
     assert np.linalg.norm(off, axis=1).max() < 1e-3
     assert np.allclose(tcp_pose(path[-1]), T1, atol=1e-6)
+
+
+def test_a_hand_turned_about_its_tcp_turns_in_steps_and_stays_there():
+    """A line that only turns the hand (30 deg about its TCP, moving nowhere) is followed in
+    steps of at most `TURN_STEP`: in one step, the IK's jump refused it."""
+    q0 = ik_tcp(top_grasp(1.0, 0.0, 0.95), dims.UR5_READY_Q)[0]
+    T0 = tcp_pose(q0)
+    T1 = T0.copy()
+    T1[:3, :3] = rotx(np.radians(30)) @ T0[:3, :3]
+    path = cartesian_line(q0, T1, 0.01)
+    assert path is not None
+    T = tcp_pose(path)
+    steps = [rotation_angle(a[:3, :3], b[:3, :3]) for a, b in itertools.pairwise(T)]
+    assert max(steps) <= TURN_STEP + 1e-9
+    assert np.abs(T[:, :3, 3] - T0[:3, 3]).max() < 1e-6
+    assert np.allclose(T[-1], T1, atol=1e-6)
 
 
 def _wall_between() -> tuple[np.ndarray, np.ndarray, CollisionChecker]:

@@ -12,7 +12,7 @@ from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.truth import SimTruth, inside_basket, on_scooter
 
-FLOOR = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+FLOOR = dims.BASKET_FLOOR
 RIM = dims.BASKET_CENTER[2] + dims.BASKET_INNER[2] / 2
 
 

@@ -212,7 +212,7 @@ def rank_drop_postures(
     carrying limits of `motion`; default: the settings')."""
     if not candidates:
         return []
-    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    floor = dims.BASKET_FLOOR
     Q = np.array(candidates)
     T = tcp_pose(Q)
     pts = falls if len(falls) else np.zeros((1, 3))

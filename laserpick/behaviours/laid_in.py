@@ -81,7 +81,7 @@ def laid_in_candidates(
         return []
     half = dims.BASKET_INNER[:2] / 2 - max(margin + PAYLOAD_POINT_RADIUS, 0.01)
     lo, hi = dims.BASKET_CENTER[:2] - half, dims.BASKET_CENTER[:2] + half
-    floor = dims.BASKET_CENTER[2] - dims.BASKET_INNER[2] / 2
+    floor = dims.BASKET_FLOOR
     free = scooter_only()
     out: list[np.ndarray] = []
     for R in [*hand_down_turns(), *squared_turns(held)]:

@@ -178,6 +178,8 @@ HANDLEBAR_WIDTH = 0.55
 BASKET_CENTER = np.array([0.99, 0.13, 0.80])
 BASKET_INNER = np.array([0.20, 0.32, 0.16])
 BASKET_WALL = 0.008
+#: The top of the basket's floor (m, base frame z).
+BASKET_FLOOR = BASKET_CENTER[2] - BASKET_INNER[2] / 2
 #: m. The basket's floor is thicker than its walls: a thin, light object let go above it
 #: (a remote, a tissue packet) falls 5 mm per 2 ms physics step, and through a floor as thin
 #: as the walls in one step. Its top is at the walls' foot.

@@ -38,7 +38,7 @@ from laserpick.description.shapes import (
     PROJECTOR_HOUSING_RAISE,
     body_frames,
 )
-from laserpick.transforms import make_transform, rotx
+from laserpick.transforms import make_transform, rotx, turn_between
 
 __all__ = [
     "ARM_RGBA",
@@ -95,14 +95,7 @@ def _at(pos, R: np.ndarray | None = None) -> np.ndarray:
 
 def _z_to(direction: np.ndarray) -> np.ndarray:
     """A rotation taking +z onto `direction` (unit), the shortest way."""
-    z = np.array([0.0, 0.0, 1.0])
-    axis = np.cross(z, direction)
-    s, c = float(np.linalg.norm(axis)), float(z @ direction)
-    if s < 1e-12:
-        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
-    k = axis / s
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    return turn_between(np.array([0.0, 0.0, 1.0]), direction)
 
 
 def _capsule(name: str, a, b, radius: float, rgba: RGBA) -> Shape:

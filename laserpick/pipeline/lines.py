@@ -12,12 +12,16 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from laserpick.description.kinematics import ik_tcp, tcp_pose
+from laserpick.transforms import rotation_angle
 
-__all__ = ["CARTESIAN_JUMP", "cartesian_line"]
+__all__ = ["CARTESIAN_JUMP", "TURN_STEP", "cartesian_line"]
 
 #: Largest joint change (rad) between neighbouring waypoints of a Cartesian line: a bigger
 #: step means the IK jumped branches (a singularity), so the line is not followed.
 CARTESIAN_JUMP = 0.25
+#: The most (rad) the hand turns between two waypoints of a line: a hand turned about its
+#: TCP, moving nowhere, reached a 30 deg turn in one step, past `CARTESIAN_JUMP`.
+TURN_STEP = 0.05
 
 
 def _lerp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
@@ -33,10 +37,12 @@ def cartesian_line(
     q_start: np.ndarray, T_goal: np.ndarray, step: float = 0.01
 ) -> np.ndarray | None:
     """Joint waypoints (K, 6) moving the TCP in a straight line from where q_start (6,) puts
-    it to T_goal, every `step` m; None where IK fails or jumps branches on the way."""
+    it to T_goal, every `step` m and every `TURN_STEP` of its turn; None where IK fails or
+    jumps branches on the way."""
     T_start = tcp_pose(q_start)
     dist = float(np.linalg.norm(T_goal[:3, 3] - T_start[:3, 3]))
-    n = max(2, math.ceil(dist / step) + 1)
+    turn = rotation_angle(T_start[:3, :3], T_goal[:3, :3])
+    n = max(2, math.ceil(dist / step) + 1, math.ceil(turn / TURN_STEP) + 1)
     path = [np.asarray(q_start, float)]
     for s in np.linspace(0.0, 1.0, n)[1:]:
         sols = ik_tcp(_lerp_pose(T_start, T_goal, float(s)), path[-1])
