@@ -41,6 +41,7 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import perceive
+from laserpick.pipeline.plan import motion_limits
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotz
@@ -262,16 +263,21 @@ def test_a_box_held_askew_is_squared_with_the_basket_and_laid_wholly_in():
     assert not any(np.allclose(turn, R, atol=1e-6) for R in hand_down_turns())
 
 
-def test_the_carry_is_timed_by_the_tcp_arc_as_well_as_the_joints():
+def test_the_carry_is_timed_by_the_tcp_arc_and_the_hand_turn_as_well_as_the_joints():
     """The straight joint move that turns the arm's base 1 rad, the hand held out at ready,
-    takes as long as the slower of the turn at the carrying joint speed and the hand's arc
-    at the TCP cap near people."""
+    takes as long as the slowest of the turn at the joint speed, the hand's arc at the TCP
+    cap near people and the hand's own turn (1 rad about the vertical) at the carrying turn
+    cap; turning the last joint alone moves the TCP nowhere and is held to the turn cap."""
     motion = SETTINGS.motion
+    limits = motion_limits(motion, carrying=True)
     turned = dims.UR5_READY_Q + [1.0, 0, 0, 0, 0, 0]
     radius = np.linalg.norm(tcp_pose(dims.UR5_READY_Q)[:2, 3] - dims.ARM_MOUNT_POS[:2])
-    expected = max(1.0 / motion.carry_joint_speed, radius * 1.0 / motion.tcp_speed)
-    got = reach_times(dims.UR5_READY_Q, turned[None], motion.carry_joint_speed, motion.tcp_speed)
+    expected = max(1.0 / motion.joint_speed, radius / motion.tcp_speed, 1.0 / limits.turn_speed)
+    got = reach_times(dims.UR5_READY_Q, turned[None], limits)
     assert got[0] == pytest.approx(expected, rel=0.02)
+    wrist = dims.UR5_READY_Q + [0, 0, 0, 0, 0, 1.5]
+    got = reach_times(dims.UR5_READY_Q, wrist[None], limits)
+    assert got[0] == pytest.approx(1.5 / motion.carry_turn_speed, rel=0.01)
 
 
 def test_of_two_drop_postures_alike_the_one_reached_sooner_ranks_first():
@@ -289,9 +295,8 @@ def test_of_two_drop_postures_alike_the_one_reached_sooner_ranks_first():
         for (ka, a), (kb, b) in itertools.permutations(ranked, 2)
         if ka[:4] == kb[:4] and np.abs(a - lifted).max() < np.abs(b - lifted).max() - 0.1
     ]
-    times = [
-        reach_times(lifted, np.array(p), motion.carry_joint_speed, motion.tcp_speed) for p in pairs
-    ]
+    limits = motion_limits(motion, carrying=True)
+    times = [reach_times(lifted, np.array(p), limits) for p in pairs]
     slower_nearer = [p for p, t in zip(pairs, times, strict=True) if t[0] > t[1] + 1.0]
     assert slower_nearer, "some posture nearer in joint space is reached a second later"
     for near, sooner in slower_nearer:

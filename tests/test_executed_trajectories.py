@@ -1,6 +1,7 @@
 """Every trajectory the arm runs in a bench episode is one a real UR5 could follow: sampled
 evenly, from rest to rest, with no jump in joint velocity between samples, and within the
-joint speed, acceleration and jerk limits and the TCP's speed caps of `MotionSettings`."""
+joint speed, acceleration and jerk limits, the TCP's speed caps and, while the hand holds
+the object, the hand's turning cap of `MotionSettings`."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import pytest
 from laserpick.bench.protocols import Options
 from laserpick.bench.runner import run
 from laserpick.description import kinematics as K
+from laserpick.pipeline.timing import Limits, excess
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.settings import get_settings
 from laserpick.types import Trajectory
@@ -37,12 +39,16 @@ def test_every_trajectory_of_a_bench_episode_is_smooth_and_within_the_limits(
     joint speed <= `joint_speed`, acceleration <= `joint_accel`, jerk <= `joint_jerk`
     (the stated bound), the change of velocity from one sample to the next <= joint_accel
     times the sample spacing (no jump, from rest at the start either), the TCP's speed <=
-    `tcp_speed`, and on the guarded approach <= `approach_speed`."""
+    `tcp_speed`, and on the guarded approach <= `approach_speed`; with the object in the
+    hand, the hand turns no faster than `carry_turn_speed`."""
     executed: list[Trajectory] = []
+    holding: list[Trajectory] = []
     real_execute = SimRobot.execute
 
     def execute(self: SimRobot, traj: Trajectory):
         executed.append(traj)
+        if self.gripper_state().holding:
+            holding.append(traj)
         return real_execute(self, traj)
 
     monkeypatch.setattr(SimRobot, "execute", execute)
@@ -61,3 +67,8 @@ def test_every_trajectory_of_a_bench_episode_is_smooth_and_within_the_limits(
         cap = s.approach_speed if traj.guard_force == s.guard_force else s.tcp_speed
         assert tcp <= cap * (1 + ROUNDING)
     assert any(t.guard_force == s.guard_force for t in executed)  # the approach was among them
+    turning = Limits(s.joint_speed, s.joint_accel, s.joint_jerk, turn_speed=s.carry_turn_speed)
+    carried = [t for t in holding if len(t.q) > 1]
+    assert len(carried) >= 3  # the re-grip's lift, the lift, the carry
+    for traj in carried:
+        assert excess(traj.q, traj.times[1] - traj.times[0], turning)["turn_speed"] <= 1 + 1e-6

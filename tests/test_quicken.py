@@ -10,7 +10,7 @@ from arm_poses import EMPTY, table, top_grasp
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.plan import joint_path, timed
+from laserpick.pipeline.plan import joint_path, motion_limits, timed
 from laserpick.pipeline.quicken import quicken, run_time
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import get_settings
@@ -29,14 +29,12 @@ def _wrist_detour() -> tuple[np.ndarray, np.ndarray]:
 def test_the_wandering_joint_goes_straight_and_the_path_is_quicker():
     detour, straight = _wrist_detour()
     checker = CollisionChecker(EMPTY)
-    s = get_settings().motion
-    out = quicken(
-        detour, checker, np.random.default_rng(0), joint_speed=s.joint_speed, tcp_speed=0.25
-    )
+    limits = motion_limits(get_settings().motion)
+    out = quicken(detour, checker, np.random.default_rng(0), limits)
     assert np.array_equal(out[0], detour[0]) and np.array_equal(out[-1], detour[-1])
-    before, after = run_time(detour, s.joint_speed, 0.25), run_time(out, s.joint_speed, 0.25)
+    before, after = run_time(detour, limits), run_time(out, limits)
     assert after < before - 0.3  # the detour costs 0.37 s
-    assert after <= run_time(straight, s.joint_speed, 0.25) + 0.1
+    assert after <= run_time(straight, limits) + 0.1
 
 
 def test_no_change_is_kept_that_the_check_refuses():
@@ -47,7 +45,7 @@ def test_no_change_is_kept_that_the_check_refuses():
     refusing = CollisionChecker(EMPTY)
     refusing.segment_ok = lambda a, b, **kw: False  # type: ignore[method-assign]
     rng = np.random.default_rng(0)
-    kept = quicken(detour, refusing, rng, joint_speed=1.0, tcp_speed=0.25)
+    kept = quicken(detour, refusing, rng, motion_limits(get_settings().motion))
     assert np.array_equal(kept, detour)
     wall = np.array(
         [[x, -0.2, z] for x in np.arange(1.45, 1.75, 0.02) for z in np.arange(0.46, 0.8, 0.02)]

@@ -116,6 +116,25 @@ def test_the_tcp_never_outruns_its_cap() -> None:
     assert excess(slow.q, slow.times[1], capped)["tcp_speed"] <= 1.0
 
 
+def test_the_hand_never_turns_faster_than_its_cap() -> None:
+    """A move that turns the base and the last joint against each other keeps the hand's
+    own turning within the cap (the joints each run faster than it), and the cap binds: a
+    turn of the last joint alone takes at least its angle over the cap."""
+    q0 = np.array([-0.4, -1.7, 1.5, 1.7, 1.57, 1.1])
+    capped = Limits(1.0, 1.5, 15.0, tcp_speed=0.25, turn_speed=0.4)
+    for dq in ([0.8, 0.0, 0.0, 0.0, 0.0, 0.6], [0.0, 0.0, 0.0, 0.0, 0.0, 1.2]):
+        traj = time_parametrize(np.stack([q0, q0 + dq]), limits=capped, tolerance=TOL)
+        _assert_smooth_within(traj, capped)
+        R = K.tcp_pose(traj.q)[:, :3, :3]
+        cos = (np.einsum("tij,tij->t", R[:-1], R[1:]) - 1.0) / 2.0
+        turn = np.arccos(np.clip(cos, -1.0, 1.0)) / np.diff(traj.times)
+        assert turn.max() <= 0.4 * (1 + 1e-6)
+        assert excess(traj.q, traj.times[1], capped)["turn_speed"] <= 1.0
+    assert traj.duration >= 1.2 / 0.4
+    free = time_parametrize(np.stack([q0, q0 + dq]), limits=LIMITS, tolerance=TOL)
+    assert free.duration < 1.2 / 0.4 - 1.0
+
+
 def test_a_straight_approach_keeps_its_speed_past_its_waypoints() -> None:
     """A straight Cartesian line (waypoints 1 cm apart, each a small corner in joint space)
     runs at the approach speed without slowing at its waypoints: 10 cm at 8 cm/s take 1.25 s

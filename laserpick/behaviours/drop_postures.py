@@ -13,6 +13,8 @@ from laserpick.behaviours.laid_in import hand_turns, laid_in_candidates, scooter
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, held_at
+from laserpick.pipeline.plan import motion_limits
+from laserpick.pipeline.timing import Limits, straight_times
 from laserpick.settings import BehaviourSettings, MotionSettings, get_settings
 
 __all__ = [
@@ -230,7 +232,7 @@ def rank_drop_postures(
     fall = (drop // settings.fall_step).astype(int)
     coarse = (drop // settings.overhang_fall_step).astype(int)
     motion = motion or get_settings().motion
-    soon = reach_times(q_ref, Q, motion.joint_speed_for(carrying=True), motion.tcp_speed)
+    soon = reach_times(q_ref, Q, motion_limits(motion, carrying=True))
     ranked = [
         (
             (0, 0, 0, int(fall[i]), float(soon[i]))
@@ -244,17 +246,12 @@ def rank_drop_postures(
     return ranked
 
 
-def reach_times(
-    q_ref: np.ndarray, Q: np.ndarray, joint_speed: float, tcp_speed: float
-) -> np.ndarray:
+def reach_times(q_ref: np.ndarray, Q: np.ndarray, limits: Limits) -> np.ndarray:
     """(B,) how long (s) the straight joint move from q_ref (6,) to each of Q (B, 6) (rad)
-    takes at `joint_speed` (rad/s) and `tcp_speed` (m/s), the slower of the two; no
-    acceleration. The TCP arc counts: a posture a little nearer in joint space may swing the
-    hand around the arm's mount, and the carry is held to the TCP cap near people."""
+    takes at the speed limits of `limits`, no acceleration (`timing.straight_times`). The
+    TCP's arc and the hand's turning count: a posture a little nearer in joint space may
+    swing the hand around the arm's mount, or turn it further, and the carry is held to
+    the TCP cap near people and the carrying turn cap."""
     if len(Q) == 0:
         return np.zeros(0)
-    s = np.linspace(0.0, 1.0, REACH_SAMPLES)[None, :, None]
-    path = q_ref[None, None] + s * (Q - q_ref)[:, None]  # (B, S, 6)
-    tcp = tcp_pose(path)[..., :3, 3]
-    arc = np.linalg.norm(np.diff(tcp, axis=1), axis=-1).sum(axis=1)
-    return np.maximum(np.abs(Q - q_ref).max(axis=1) / joint_speed, arc / tcp_speed)
+    return straight_times(np.broadcast_to(q_ref, Q.shape), Q, limits, REACH_SAMPLES)

@@ -124,7 +124,7 @@ class GuardedMotion:
         if len(path) < 2 or np.max(np.abs(path[-1] - q)) < b.start_tolerance:
             return True
         s = self.settings.motion
-        way_back = timed(path, s, joint_speed=s.joint_speed_for(carrying=self.held is not None))
+        way_back = timed(path, s, carrying=self.held is not None)
         handle = self.robot.execute(way_back)
         return self.robot.wait(handle, way_back.duration + b.motion_slack) == "done"
 
@@ -150,7 +150,7 @@ class GuardedMotion:
     ) -> Outcome:
         """A collision-free joint move to q_goal (6,) rad (`joint_path_via`, then `follow`).
         kw: passed to `joint_path` (`payload`, TCP frame: what the hand carries, which also
-        slows the move to the carrying speed, `joint_speed_for`). The outcome's timings
+        holds the move to the carrying limits, `motion_limits`). The outcome's timings
         give the wall-clock seconds the search took (`SEARCH`)."""
         s, t0 = self.settings.motion, time.perf_counter()
         path = joint_path_via(self.current_q(), q_goal, checker, self.rng, s, via, **kw)
@@ -164,15 +164,14 @@ class GuardedMotion:
         self, path: np.ndarray, checker: CollisionChecker, what: str, **kw
     ) -> Failure | None:
         """Run the searched joint `path` (K, 6) rad (`run`), its corners blended where the
-        check it was searched with (`checker`, kw) passes, at the carrying speed where kw
-        has a `payload`."""
-        s = self.settings.motion
-        speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
+        check it was searched with (`checker`, kw) passes, within the carrying limits where
+        kw has a `payload`."""
+        carrying = kw.get("payload") is not None
 
         def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
             return checker.clearance_ok(Q, **kw)
 
-        return self.run(timed(path, s, joint_speed=speed, clear=clear), what)
+        return self.run(timed(path, self.settings.motion, carrying=carrying, clear=clear), what)
 
     def descend(
         self, path: np.ndarray, tcp_speed: float, what: str, *, felt: float = 0.0

@@ -18,7 +18,7 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.laser_spots import detect_mark
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.perceive import Perception, perceive
-from laserpick.pipeline.plan import PickPlan, joint_path, plan_pick, timed
+from laserpick.pipeline.plan import PickPlan, joint_path, motion_limits, plan_pick, timed
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled, ViewMemory
@@ -45,6 +45,7 @@ __all__ = [
     "highlight_disc",
     "highlight_points",
     "joint_path",
+    "motion_limits",
     "perceive",
     "place_target",
     "plan_first",

@@ -5,8 +5,7 @@ lines (`lines`) for the approach and the lift. When a joint-space move collides,
 RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: ours, shortened by
 random shortcuts (`rrt`), or OMPL's, shortened by OMPL's path simplifier (`ompl_search`;
 `MotionSettings.planner`). Every path is checked against a `CollisionChecker`, then
-time-parametrized within the joint speed, joint acceleration and TCP speed limits of
-`MotionSettings`.
+time-parametrized within the motion limits of `MotionSettings` (`motion_limits`).
 
 Frames: TCP poses in `base` (m); joint angles in rad.
 """
@@ -74,12 +73,12 @@ def joint_path(
         path = None if path is None else shortcut(path, checker, rng, **kw)
     if path is None or not s.quicken_paths:
         return path
-    # A carry runs at the carrying speed (`GuardedMotion.go_to`): so is its path quickened.
-    speed = s.joint_speed_for(carrying=kw.get("payload") is not None)
-    quick = quicken(path, checker, rng, joint_speed=speed, tcp_speed=s.tcp_speed, **kw)
+    # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
+    carrying = kw.get("payload") is not None
+    quick = quicken(path, checker, rng, motion_limits(s, carrying=carrying), **kw)
     quick = shortcut(quick, checker, rng, **kw)
     # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
-    return min((path, quick), key=lambda p: timed(p, s, joint_speed=speed).duration)
+    return min((path, quick), key=lambda p: timed(p, s, carrying=carrying).duration)
 
 
 def joint_path_via(
@@ -156,29 +155,38 @@ class Searches:
         return self.failed >= self.max_failed
 
 
+def motion_limits(
+    s: MotionSettings, *, carrying: bool = False, tcp_speed: float | None = None
+) -> Limits:
+    """The limits every move the arm runs keeps, from `s`: the joint speed, acceleration and
+    jerk, the TCP speed cap near people, lowered to `tcp_speed` (m/s) where given (the
+    approach, the lift; never raised), and while `carrying` the hand's turning cap
+    (`carry_turn_speed`)."""
+    return Limits(
+        speed=s.joint_speed,
+        accel=s.joint_accel,
+        jerk=s.joint_jerk,
+        tcp_speed=min(tcp_speed or s.tcp_speed, s.tcp_speed),
+        turn_speed=s.carry_turn_speed if carrying else None,
+    )
+
+
 def timed(
     path: np.ndarray,
     s: MotionSettings,
     *,
     tcp_speed: float | None = None,
-    joint_speed: float | None = None,
+    carrying: bool = False,
     gripper: tuple[tuple[int, str], ...] = (),
     clear: Sequence[ClearFn | None] | ClearFn | None = None,
 ) -> Trajectory:
-    """Time-parametrize a joint path within the motion limits of `s` (`timing`): its
-    corners blended, within `blend_tolerance` of the path, or `blend_checked` where the
-    legs' collision checks `clear` (one for all legs, or one per leg) pass the blend.
-    `tcp_speed` (m/s) and `joint_speed` (rad/s) lower the TCP and joint speed limits, e.g.
-    on the approach and while carrying; they never raise them."""
-    limits = Limits(
-        speed=min(joint_speed or s.joint_speed, s.joint_speed),
-        accel=s.joint_accel,
-        jerk=s.joint_jerk,
-        tcp_speed=min(tcp_speed or s.tcp_speed, s.tcp_speed),
-    )
+    """Time-parametrize a joint path within the motion limits of `s` (`motion_limits`,
+    `timing`): its corners blended, within `blend_tolerance` of the path, or
+    `blend_checked` where the legs' collision checks `clear` (one for all legs, or one per
+    leg) pass the blend."""
     return time_parametrize(
         path,
-        limits=limits,
+        limits=motion_limits(s, carrying=carrying, tcp_speed=tcp_speed),
         tolerance=s.blend_tolerance,
         checked_tolerance=s.blend_checked,
         clear=clear,

@@ -6,9 +6,9 @@ back), and joins between the path's own vertices (`rrt.shortcut`) cannot straigh
 joint alone.
 
 A change is kept only where it is clear by the same check as the search's, and quicker by
-`run_time`, the time the path takes at the joint speed limit or the TCP speed cap,
-whichever binds on each segment: what the arm's timing spends (`timing`), less its
-accelerations. Frames: joint angles in rad; TCP in `base`, m.
+`run_time`, the time the path takes at the joint speed limit, the TCP speed cap or the
+hand's turning cap, whichever binds on each segment: what the arm's timing spends
+(`timing`), less its accelerations. Frames: joint angles in rad; TCP in `base`, m.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import itertools
 
 import numpy as np
 
-from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.timing import Limits, straight_times
 
 __all__ = ["quicken", "run_time"]
 
@@ -29,20 +29,15 @@ ARC_SAMPLES = 6
 LEAST_GAIN = 0.02
 
 
-def _segment_times(path: np.ndarray, joint_speed: float, tcp_speed: float) -> np.ndarray:
-    """(K-1,) the least time (s) each segment of `path` (K, 6) rad takes: its largest joint
-    motion at `joint_speed` (rad/s), or its TCP arc at `tcp_speed` (m/s), the longer."""
-    a, b = path[:-1], path[1:]
-    f = np.linspace(0.0, 1.0, ARC_SAMPLES)[None, :, None]
-    Q = a[:, None, :] + f * (b - a)[:, None, :]
-    p = tcp_pose(Q.reshape(-1, 6))[:, :3, 3].reshape(len(a), ARC_SAMPLES, 3)
-    arc = np.linalg.norm(np.diff(p, axis=1), axis=2).sum(axis=1)
-    return np.maximum(np.abs(b - a).max(axis=1) / joint_speed, arc / tcp_speed)
+def _segment_times(path: np.ndarray, limits: Limits) -> np.ndarray:
+    """(K-1,) the least time (s) each segment of `path` (K, 6) rad takes at the speed
+    limits (`timing.straight_times`)."""
+    return straight_times(path[:-1], path[1:], limits, ARC_SAMPLES)
 
 
-def run_time(path: np.ndarray, joint_speed: float, tcp_speed: float) -> float:
+def run_time(path: np.ndarray, limits: Limits) -> float:
     """The least time (s) `path` (K, 6) rad takes at the speed limits (`_segment_times`)."""
-    return float(_segment_times(np.asarray(path, float), joint_speed, tcp_speed).sum())
+    return float(_segment_times(np.asarray(path, float), limits).sum())
 
 
 def _point_at(path: np.ndarray, along: np.ndarray, t: float) -> tuple[int, np.ndarray]:
@@ -57,17 +52,16 @@ def quicken(
     path: np.ndarray,
     checker: CollisionChecker,
     rng: np.random.Generator,
+    limits: Limits,
     *,
-    joint_speed: float,
-    tcp_speed: float,
     tries: int = 40,
     **kw,
 ) -> np.ndarray:
     """`path` (K, 6) rad with `tries` random partial shortcuts tried, each kept where its new
     segments pass `checker.segment_ok(..., **kw)` and it saves LEAST_GAIN s of `run_time`
-    at `joint_speed` (rad/s) and `tcp_speed` (m/s). The ends stay where they are."""
+    at the speed limits of `limits`. The ends stay where they are."""
     path = np.array(path, float)
-    times = _segment_times(path, joint_speed, tcp_speed)
+    times = _segment_times(path, limits)
     for _ in range(tries):
         along = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(path, axis=0)).max(axis=1))])
         if len(path) < 2 or along[-1] <= 0.0:
@@ -81,7 +75,7 @@ def quicken(
         middle = path[k1 + 1 : k2 + 1].copy()
         middle[:, joint] = np.interp(along[k1 + 1 : k2 + 1], [t1, t2], [q1[joint], q2[joint]])
         piece = np.vstack([path[k1], q1, middle, q2, path[k2 + 1]])
-        new_times = _segment_times(piece, joint_speed, tcp_speed)
+        new_times = _segment_times(piece, limits)
         if new_times.sum() > times[k1 : k2 + 1].sum() - LEAST_GAIN:
             continue
         if not all(checker.segment_ok(a, b, **kw) for a, b in itertools.pairwise(piece)):
@@ -93,5 +87,5 @@ def quicken(
             end = path[-1].copy()
             path = path[np.concatenate([[True], ~repeated])]
             path[-1] = end
-            times = _segment_times(path, joint_speed, tcp_speed)
+            times = _segment_times(path, limits)
     return path

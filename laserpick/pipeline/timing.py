@@ -41,7 +41,7 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.smoothing import BlendedPath, ClearFn, corners
 from laserpick.types import GripperEvent, Trajectory
 
-__all__ = ["Limits", "excess", "time_parametrize"]
+__all__ = ["Limits", "excess", "straight_times", "time_parametrize"]
 
 #: TOPP-RA's grid: at most this far apart (rad of path), and at least this many intervals
 #: in every piece of the path (a blend's curvature changes within it).
@@ -73,18 +73,22 @@ SLOWDOWNS = 8
 @dataclass(frozen=True)
 class Limits:
     """The motion's limits: joint speed (rad/s), acceleration (rad/s^2) and jerk (rad/s^3),
-    each for every joint; the TCP's speed (m/s, None: no cap)."""
+    each for every joint; the TCP's speed (m/s, None: no cap) and the hand's turning speed
+    (rad/s, the TCP frame's angular speed in `base`; None: no cap)."""
 
     speed: float
     accel: float
     jerk: float
     tcp_speed: float | None = None
+    turn_speed: float | None = None
 
     def __post_init__(self) -> None:
         if not (self.speed > 0 and self.accel > 0 and self.jerk > 0):
             raise ValueError("joint speed, acceleration and jerk limits must be positive")
         if self.tcp_speed is not None and not self.tcp_speed > 0:
             raise ValueError("the TCP speed cap must be positive")
+        if self.turn_speed is not None and not self.turn_speed > 0:
+            raise ValueError("the hand's turning speed cap must be positive")
 
 
 class _Path(toppra.interpolator.AbstractGeometricPath):
@@ -106,28 +110,66 @@ class _Path(toppra.interpolator.AbstractGeometricPath):
         return self._interval
 
 
-class _SpeedBound(toppra.constraint.LinearConstraint):
-    """Bounds on sd^2 at each grid point: the TCP's speed |dp/ds| sd <= tcp_speed (None: no
-    cap), and sd <= caps (N,), the grid's own caps."""
+def _turn_angles(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
+    """The angles (rad) of the turns from rotations R0 to R1 (..., 3, 3)."""
+    M = np.swapaxes(R0, -1, -2) @ R1
+    skew = M - np.swapaxes(M, -1, -2)
+    sin2 = np.linalg.norm(skew[..., [2, 0, 1], [1, 2, 0]], axis=-1)  # 2 sin(angle)
+    cos2 = np.trace(M, axis1=-2, axis2=-1) - 1.0  # 2 cos(angle)
+    return np.arctan2(sin2, cos2)
 
-    def __init__(self, tcp_speed: float | None, caps: np.ndarray) -> None:
+
+def straight_times(a: np.ndarray, b: np.ndarray, limits: Limits, samples: int = 6) -> np.ndarray:
+    """(B,) the least time (s) each straight joint move from a (B, 6) to b (B, 6) (rad)
+    takes at the speed limits, its accelerations left out: the largest joint's motion at
+    the joint speed, the TCP's arc at its cap and the hand's turning at its cap, the
+    slowest. The arc and the turns are summed over `samples` configurations along the
+    move: a joint move swings the hand along an arc, not a chord."""
+    a, b = np.atleast_2d(a), np.atleast_2d(b)
+    f = np.linspace(0.0, 1.0, samples)[None, :, None]
+    T = tcp_pose((a[:, None, :] + f * (b - a)[:, None, :]).reshape(-1, 6))
+    T = T.reshape(len(a), samples, 4, 4)
+    times = [np.abs(b - a).max(axis=1) / limits.speed]
+    if limits.tcp_speed is not None:
+        arc = np.linalg.norm(np.diff(T[:, :, :3, 3], axis=1), axis=2).sum(axis=1)
+        times.append(arc / limits.tcp_speed)
+    if limits.turn_speed is not None:
+        turn = _turn_angles(T[:, :-1, :3, :3], T[:, 1:, :3, :3]).sum(axis=1)
+        times.append(turn / limits.turn_speed)
+    return np.maximum.reduce(times)
+
+
+class _SpeedBound(toppra.constraint.LinearConstraint):
+    """Bounds on sd^2 at each grid point: the TCP's speed |dp/ds| sd <= tcp_speed and the
+    hand's turning speed |dR/ds| sd <= turn_speed (None: no cap), and sd <= caps (N,), the
+    grid's own caps."""
+
+    def __init__(self, limits: Limits, caps: np.ndarray) -> None:
         super().__init__()
-        self.tcp_speed = tcp_speed
+        self.limits = limits
         self.caps = caps
         self.dof = 6
 
     def compute_constraint_params(self, path, gridpoints):
         xbound = np.zeros((len(gridpoints), 2))
         xbound[:, 1] = np.minimum(self.caps, LARGE) ** 2
-        if self.tcp_speed is not None:
-            q, dq = path(gridpoints, 0), path(gridpoints, 1)
-            ahead = tcp_pose(q + _EPS * dq)[:, :3, 3]
-            behind = tcp_pose(q - _EPS * dq)[:, :3, 3]
-            rate = np.linalg.norm(ahead - behind, axis=1) / (2 * _EPS)  # m per rad of path
+        tcp_speed, turn_speed = self.limits.tcp_speed, self.limits.turn_speed
+        if tcp_speed is None and turn_speed is None:
+            return None, None, None, None, None, None, xbound
+        q, dq = path(gridpoints, 0), path(gridpoints, 1)
+        ahead, behind = tcp_pose(q + _EPS * dq), tcp_pose(q - _EPS * dq)
+        rates = []  # (limit, its unit per rad of path)
+        if tcp_speed is not None:
+            step = np.linalg.norm(ahead[:, :3, 3] - behind[:, :3, 3], axis=1)
+            rates.append((tcp_speed, step / (2 * _EPS)))
+        if turn_speed is not None:
+            turn = _turn_angles(behind[:, :3, :3], ahead[:, :3, :3])
+            rates.append((turn_speed, turn / (2 * _EPS)))
+        for limit, rate in rates:
             # The largest of its neighbours too: the bound holds between grid points.
             edge = np.pad(rate, 1, mode="edge")
             rate = np.maximum.reduce([edge[:-2], rate, edge[2:]])
-            cap = self.tcp_speed * INSIDE / np.maximum(rate, 1e-9)
+            cap = limit * INSIDE / np.maximum(rate, 1e-9)
             xbound[:, 1] = np.minimum(xbound[:, 1], cap**2)
         return None, None, None, None, None, None, xbound
 
@@ -148,7 +190,7 @@ def _fastest(path: BlendedPath, grid: np.ndarray, limits: Limits, caps: np.ndarr
     constraints = [
         toppra.constraint.JointVelocityConstraint(np.full(6, limits.speed * INSIDE)),
         toppra.constraint.JointAccelerationConstraint(np.full(6, limits.accel * INSIDE)),
-        _SpeedBound(limits.tcp_speed, caps),
+        _SpeedBound(limits, caps),
     ]
     algo = toppra.algorithm.TOPPRA(constraints, _Path(path), gridpoints=grid)
     _, sd, _ = algo.compute_parameterization(0.0, 0.0)
@@ -196,8 +238,8 @@ class _Profile:
 
 def _ratios(q: np.ndarray, h: float, limits: Limits) -> dict[str, np.ndarray]:
     """Per sample of q (T, 6) rad, h s apart, the largest ratio to its limit of the joint
-    speeds, accelerations and jerks and the TCP's speed that it takes part in: by finite
-    differences, the arm at rest before and after."""
+    speeds, accelerations and jerks, the TCP's speed and the hand's turning speed that it
+    takes part in: by finite differences, the arm at rest before and after."""
     pad = 3
     rest = np.vstack([np.repeat(q[:1], pad, axis=0), q, np.repeat(q[-1:], pad, axis=0)])
     v = np.abs(np.diff(rest, axis=0)).max(axis=1) / h
@@ -215,25 +257,35 @@ def _ratios(q: np.ndarray, h: float, limits: Limits) -> dict[str, np.ndarray]:
         "accel": per_sample(a) / limits.accel,
         "jerk": per_sample(j) / limits.jerk,
         "tcp_speed": np.zeros(n),
+        "turn_speed": np.zeros(n),
     }
-    if limits.tcp_speed is not None and n > 1:
-        p = tcp_pose(q)[:, :3, 3]
-        step = np.linalg.norm(np.diff(p, axis=0), axis=1) / h / limits.tcp_speed
-        out["tcp_speed"] = np.maximum(np.append(step, 0.0), np.insert(step, 0, 0.0))
+    if n < 2 or (limits.tcp_speed is None and limits.turn_speed is None):
+        return out
+    T = tcp_pose(q)
+    steps = {}
+    if limits.tcp_speed is not None:
+        steps["tcp_speed"] = np.linalg.norm(np.diff(T[:, :3, 3], axis=0), axis=1) / limits.tcp_speed
+    if limits.turn_speed is not None:
+        steps["turn_speed"] = _turn_angles(T[:-1, :3, :3], T[1:, :3, :3]) / limits.turn_speed
+    for name, step in steps.items():
+        step = step / h
+        out[name] = np.maximum(np.append(step, 0.0), np.insert(step, 0, 0.0))
     return out
 
 
 def excess(q: np.ndarray, h: float, limits: Limits) -> dict[str, float]:
     """How far samples q (T, 6) rad, h s apart, go over each limit: the largest ratio of
-    value to limit of joint speed, acceleration, jerk and TCP speed, by finite differences,
+    value to limit of joint speed, acceleration, jerk, TCP speed and the hand's turning
+    speed, by finite differences,
     the arm at rest before and after (1 is at the limit)."""
     return {name: float(r.max()) for name, r in _ratios(q, h, limits).items()}
 
 
 def _slowdown(ratios: dict[str, np.ndarray]) -> np.ndarray:
     """Per sample, how many times slower the arm must go there to keep the joint speed,
-    acceleration and TCP speed limits."""
-    return np.maximum.reduce([ratios["speed"], ratios["tcp_speed"], np.sqrt(ratios["accel"])])
+    acceleration, TCP speed and turning speed limits."""
+    speeds = [ratios["speed"], ratios["tcp_speed"], ratios["turn_speed"]]
+    return np.maximum.reduce([*speeds, np.sqrt(ratios["accel"])])
 
 
 def _sampled(

@@ -46,13 +46,14 @@ class MotionSettings(BaseModel):
         " the UR5's datasheet gives none, and a trajectory without one jumps in acceleration.",
     )
     tcp_speed: float = Field(0.25, gt=0, description="TCP speed limit near people (m/s).")
-    carry_joint_speed: float = Field(
-        0.5,
+    carry_turn_speed: float = Field(
+        0.75,
         gt=0,
-        le=3.14,
-        description="Joint speed limit (rad/s) while carrying an object: a swinging object"
-        " held by a rim or an edge turns in the pads. Ours: at 0.75 a tissue packet fell"
-        " from the hand in `isolation` (docs/behaviours.md, Time).",
+        description="How fast (rad/s) the hand may turn while it carries an object (the TCP"
+        " frame's angular speed): an object held by a rim or an edge swings and turns in the"
+        " pads. Ours: the carries of `isolation` at a 0.5 rad/s joint limit turned the hand"
+        " at up to 1.5 rad/s; with the joints at 0.75 rad/s and no such cap a tissue packet"
+        " fell from the hand (docs/behaviours.md, Time).",
     )
     approach_speed: float = Field(
         0.08, gt=0, description="TCP speed (m/s) on the last, guarded approach to a grasp. Ours."
@@ -125,10 +126,11 @@ class MotionSettings(BaseModel):
         " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
     quicken_paths: bool = Field(
-        False,
+        True,
         description="Make each searched joint path quicker to run by partial shortcuts"
-        " (pipeline/quicken.py). Off by default until traced: on, the server test's TV remote"
-        " was set down 7.2 cm from its mark against the 5 cm it promises (docs/pipeline.md).",
+        " (pipeline/quicken.py): a search's path wanders in joints no obstacle needed, and"
+        " the carry's turn cap makes a wandering wrist slow. Ours: without them, `isolation`'s"
+        " carry took 8.59 s rather than 7.61 s (docs/pipeline.md).",
     )
     search_time: float = Field(
         60.0,
@@ -189,8 +191,3 @@ class MotionSettings(BaseModel):
                 f" {self.regrip_lift}, {self.lift_least}, {self.lift_low}, {self.lift}"
             )
         return self
-
-    def joint_speed_for(self, carrying: bool) -> float:
-        """The joint speed limit (rad/s) of a move: `carry_joint_speed` while the hand
-        carries something, else `joint_speed`. Every move the arm runs asks here."""
-        return min(self.carry_joint_speed, self.joint_speed) if carrying else self.joint_speed
