@@ -14,6 +14,7 @@ from arm_setups import box_points
 from driving import drive_straight
 
 from laserpick.behaviours import PAST_THE_OPENING, Held, Outcome
+from laserpick.behaviours.hand import GRIPPER_TIME
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.grasp_choice import GraspSet
@@ -21,6 +22,7 @@ from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.truth import SimTruth
 from laserpick.server.session import (
+    FELL_WHILE_DRIVING,
     PLACED_NOT_STANDING,
     PUT_BACK,
     RESTING_STATES,
@@ -365,6 +367,30 @@ def test_after_a_drive_with_the_object_in_hand_its_surroundings_are_taken_anew()
         assert on_the_table(here.surroundings.points) == 0
         assert session.state == TaskState.IDLE and session.failure is None, session.message
         assert truth.in_basket("mug_1")
+    finally:
+        session.close()
+
+
+def test_the_user_hears_at_once_when_the_object_falls_from_the_hand_as_they_drive() -> None:
+    """The mug is kept (a place cancelled) and the scooter drives back with it. Taken out of
+    the hand, as an object that turned out of the pads falls, the next drive command finds
+    the hand empty: the session says so at once, holds nothing, and the drive still goes
+    (the user drives)."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    try:
+        robot, actor = session.robot, Actor("bench")
+        _mug_kept(session, actor)
+        drive_straight(session, actor, -0.2, 0.2)
+        assert session.state == TaskState.HOLDING and session.failure is None
+        SimTruth(robot).take_out("mug_1")
+        robot.sleep(GRIPPER_TIME)  # the fingers close on nothing
+        start = robot.base_pose()
+        drive_straight(session, actor, -0.2, 0.2)
+        assert session.state == TaskState.IDLE
+        assert session.failure == Failure("execute", FELL_WHILE_DRIVING)
+        assert session.message == FELL_WHILE_DRIVING
+        assert session.behaviours.held is None
+        assert np.linalg.norm(robot.base_pose()[:2] - start[:2]) > 0.15, "it still drove"
     finally:
         session.close()
 

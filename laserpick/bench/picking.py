@@ -354,8 +354,9 @@ class ScriptedOperator:
         """Mark `spot` (m, `base`) as where the held object goes, and let the session place it."""
         s = self.session
         if s.state not in HOLDING_STATES:  # holding after a failed place: aiming marks again
-            failure = Failure("precondition", f"nothing to place (the session is {s.state.value})")
-            return Placed(failure, None)
+            # Why the hand emptied, where the session said (it fell while the user drove).
+            nothing = Failure("precondition", f"nothing to place (the session is {s.state.value})")
+            return Placed(s.failure or nothing, None)
         self.aim(spot, watched=True)
         hits = self.robot.laser_hits()
         hit = self.referee.to_base(hits[0]) if hits else None

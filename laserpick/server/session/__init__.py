@@ -18,7 +18,7 @@ Frames: points in `base` (m) unless a method says `world`; angles in radians.
 from laserpick.server.session.captures import CAPTURE_MAX_AGE, CamerasUnavailable, Capture
 from laserpick.server.session.core import Findings
 from laserpick.server.session.foresight import Foreseen
-from laserpick.server.session.motion import ESTOP_REASON
+from laserpick.server.session.motion import ESTOP_REASON, FELL_WHILE_DRIVING
 from laserpick.server.session.retreat import HELD_MOVED, HELD_TURNED, PLACED_NOT_STANDING, PUT_BACK
 from laserpick.server.session.session import Session
 from laserpick.server.session.states import (
@@ -44,6 +44,7 @@ __all__ = [
     "AIMABLE",
     "CAPTURE_MAX_AGE",
     "ESTOP_REASON",
+    "FELL_WHILE_DRIVING",
     "HELD_MOVED",
     "HELD_TURNED",
     "HOLDING_STATES",
