@@ -119,7 +119,7 @@ class BasketDrop(Carrying, Leaving, Stowing):
             margin=self.settings.motion.clearance,
             filtered=True,
         )
-        self.free_the_pads()
+        self.free_the_pads(held.surroundings)
         failure = self.rise_clear(around, hand_on_the_way=held.surroundings)
         if failure is not None:
             return Outcome(failure)

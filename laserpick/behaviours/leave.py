@@ -66,27 +66,29 @@ class Leaving(Withdrawing):
             return None
         return self.run_withdrawal(back)
 
-    def free_the_pads(self) -> bool:
+    def free_the_pads(self, checker: CollisionChecker) -> bool:
         """Where the open hand's pads still press what it let go of (`pads_clear`), lower
         it `leave_drop` (a pad under a lip leaves it) and ease the pads off sideways
         (`_slide_pads_off`), so that the hand can rise without it; where they still press
-        then, tip it off them (`_tip_off`). Say whether they were pressed. Over the basket,
-        a spray bottle wedged against a pad at 27 N was lifted 4 cm by the rising hand and
-        flung out on the way to ready."""
+        then, tip it off them (`_tip_off`, clear of `checker`). Say whether they were
+        pressed. Over the basket, a spray bottle wedged against a pad at 27 N was lifted 4
+        cm by the rising hand and flung out on the way to ready."""
         if not self._pads_still_pressed():
             return False
         self._lower_open_hand(tcp_pose(self.current_q()))
         self._slide_pads_off()
         if self._pads_still_pressed():
-            self._tip_off()
+            self._tip_off(checker)
         return True
 
-    def _tip_off(self) -> None:
-        """Turn the open hand about its TCP to point straight down, guarded, and back: what
-        hangs from a tilted pad's edge slides off it. A pill bottle let go from a hand
-        tilted 30 deg hung from the lower pad by its cap's lip, and eased sideways, went with
-        the pad; turned upright, the hand let it fall. Turned back, the hand leaves from the
-        posture it let go in, which the carry's search found clear."""
+    def _tip_off(self, checker: CollisionChecker) -> None:
+        """Turn the open hand about its TCP toward pointing straight down, as far as that
+        turn is clear of `checker`, guarded, and back: what hangs from a tilted pad's edge
+        slides off it. A pill bottle let go from a hand tilted 30 deg hung from the lower
+        pad by its cap's lip, and eased sideways, went with the pad; turned 14 deg (upright,
+        the wrist would have come within the keep-out ahead of the rider's hands) and back,
+        the hand let it fall. Turned back, it leaves from the posture it let go in, which
+        the carry's search found clear."""
         s = self.settings.motion
         start = self.current_q()
         T = tcp_pose(start)
@@ -94,6 +96,10 @@ class Leaving(Withdrawing):
         upright[:3, :3] = turn_between(T[:3, 2], np.array([0.0, 0.0, -1.0])) @ T[:3, :3]
         turn = cartesian_line(start, upright, s.cartesian_step / 5)
         if turn is None:
+            return
+        blocked = np.flatnonzero(~checker.clearance_ok(turn))
+        turn = turn[: blocked[0] if len(blocked) else len(turn)]
+        if len(turn) < 2:
             return
         guard = pad_force(self.robot) + s.place_contact_force
         for path in (turn, turn[::-1]):
