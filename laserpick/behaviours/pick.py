@@ -168,7 +168,11 @@ class Picking(Withdrawing):
         wait_for_gripper(self.robot)
         closed = self.robot.gripper_state().width
         failure = failure or self.run(plan.lift, "lifting")
-        self.robot.sleep(0.3)
+        # The hold is judged with the fingers still: an object slipping out lets them close
+        # on, and they stop on the next hold or shut. A firm hold is judged at once, rather
+        # than after a fixed 0.3 s that every attempt spent.
+        if self.robot.gripper_state().moving:
+            wait_for_gripper(self.robot)
         if failure is None and not self.robot.gripper_state().holding:
             failure = Failure("execute", "The object slipped out of the hand while lifting.")
         return failure, closed
