@@ -48,24 +48,21 @@ def path_to_a_drop(
     settings: Settings,
     rng: np.random.Generator,
 ) -> np.ndarray | None:
-    """The joint path (K, 6) rad from q_from to the first of the best `drop_tries` of
-    `drops` that a search with `rng` reaches, through the high ready pose where the straight
+    """The joint path (K, 6) rad from q_from to one of the best `drop_tries` of `drops`: the
+    straight move to the first that has one, else the first a search with `rng` toward all
+    of them at once reaches (`joint_path`), through the high ready pose where the direct
     search finds none; None where none does."""
     b = settings.behaviour
     high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
-    for q_drop in drops[: b.drop_tries]:
-        path = joint_path_via(
-            q_from,
-            q_drop,
-            held.surroundings,
-            rng,
-            settings.motion,
-            via=(high,),
-            payload=held.points_tcp,
-        )
-        if path is not None:
-            return path
-    return None
+    return joint_path_via(
+        q_from,
+        np.array(drops[: b.drop_tries]),
+        held.surroundings,
+        rng,
+        settings.motion,
+        via=(high,),
+        payload=held.points_tcp,
+    )
 
 
 def basket_way(

@@ -57,20 +57,19 @@ def joint_path(
     OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
     shortcuts (`quicken`) where the timing says so. None at once when the start or the goal
     is not clear: no edge can leave it, and the search would spend all its samples (seconds)
-    finding that out."""
-    if checker.segment_ok(q_start, q_goal, **kw):
-        return np.array([q_start, q_goal], float)
-    if not checker.clearance_ok(np.array([q_start, q_goal]), **kw).all():
+    finding that out.
+
+    q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
+    else a search toward those that are clear (`_search`), which ends at the goal it reaches.
+    """
+    goals = np.atleast_2d(np.asarray(q_goal, float))
+    for goal in goals:
+        if checker.segment_ok(q_start, goal, **kw):
+            return np.array([q_start, goal], float)
+    ends_clear = checker.clearance_ok(np.vstack([q_start, goals]), **kw)
+    if not ends_clear[0] or not ends_clear[1:].any():
         return None
-    record_search(q_start, q_goal, checker, kw)
-    if s.planner == "ompl":
-        budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
-        path = ompl_connect(q_start, q_goal, checker, rng, **budget, **kw)
-    else:
-        path = rrt_connect(
-            q_start, q_goal, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
-        )
-        path = None if path is None else shortcut(path, checker, rng, **kw)
+    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw)
     if path is None or not s.quicken_paths:
         return path
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
@@ -79,6 +78,35 @@ def joint_path(
     quick = shortcut(quick, checker, rng, **kw)
     # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
     return min((path, quick), key=lambda p: timed(p, s, carrying=carrying).duration)
+
+
+def _search(
+    q_start: np.ndarray,
+    goals: np.ndarray,
+    checker: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    kw: dict,
+) -> np.ndarray | None:
+    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first;
+    None where the search found none. Ours grows the goal side from every goal at once:
+    searched one after another, goals in a pocket spent the whole search each (a cereal
+    box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
+    its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
+    it searches them one after another."""
+    for goal in goals:
+        record_search(q_start, goal, checker, kw)
+    if s.planner == "ours":
+        path = rrt_connect(
+            q_start, goals, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
+        )
+        return None if path is None else shortcut(path, checker, rng, **kw)
+    budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
+    for goal in goals:
+        path = ompl_connect(q_start, goal, checker, rng, **budget, **kw)
+        if path is not None:
+            return path
+    return None
 
 
 def joint_path_via(
@@ -90,8 +118,9 @@ def joint_path_via(
     via: Sequence[np.ndarray] = (),
     **kw,
 ) -> np.ndarray | None:
-    """`joint_path`; where it finds none, through each configuration of `via` (6,) rad in
-    turn: two shorter searches instead of one long. None where no search found a path."""
+    """`joint_path` to q_goal (6,) or to the first reached of goals (k, 6) rad; where it finds
+    none, through each configuration of `via` (6,) rad in turn: two shorter searches
+    instead of one long. None where no search found a path."""
     path = joint_path(q_start, q_goal, checker, rng, s, **kw)
     for q_via in via:
         if path is not None:

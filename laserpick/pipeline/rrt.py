@@ -29,9 +29,11 @@ POCKET_STEP = 0.25
 
 def search_bounds(q_start: np.ndarray, q_goal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The box (lo, hi) (6,) rad that samples are drawn from: the joint limits, within a half
-    turn of the box around start and goal (a way around an obstacle needs no more)."""
-    lo = np.maximum(dims.UR5_Q_MIN, np.minimum(q_start, q_goal) - math.pi)
-    hi = np.minimum(dims.UR5_Q_MAX, np.maximum(q_start, q_goal) + math.pi)
+    turn of the box around the start and the goal, or goals (k, 6) (a way around an obstacle
+    needs no more)."""
+    ends = np.vstack([q_start, q_goal])
+    lo = np.maximum(dims.UR5_Q_MIN, ends.min(axis=0) - math.pi)
+    hi = np.minimum(dims.UR5_Q_MAX, ends.max(axis=0) + math.pi)
     return lo, hi
 
 
@@ -64,12 +66,12 @@ def shortcut(
 
 
 class _Tree:
-    """One tree of the search: its nodes (rad), each one's parent (-1: the root), and how
-    many of its steps were blocked."""
+    """One tree of the search, or a forest of trees grown together: its nodes (rad), each
+    one's parent (-1: a root), and how many of its steps were blocked."""
 
-    def __init__(self, root: np.ndarray) -> None:
-        self.nodes = [root]
-        self.parents = [-1]
+    def __init__(self, roots: np.ndarray) -> None:
+        self.nodes = list(np.atleast_2d(roots))
+        self.parents = [-1] * len(self.nodes)
         self.blocked = 0
 
     def in_pocket(self, traps: int | None) -> bool:
@@ -102,10 +104,13 @@ def rrt_connect(
     Two trees grow toward random samples within the joint limits and toward each other, in
     steps of at most `step` rad (largest joint); each new edge is collision-checked. A tree
     still small after `pocket_traps` blocked steps takes shorter ones (POCKET_TRAPS; None:
-    never).
+    never). q_goal (k, 6) gives k goals: the goal side grows from all of them at once, and
+    the path ends at the one it reached first.
     """
-    lo, hi = search_bounds(q_start, q_goal)
-    trees = [_Tree(np.asarray(q_start, float)), _Tree(np.asarray(q_goal, float))]
+    start = np.asarray(q_start, float)
+    goals = np.atleast_2d(np.asarray(q_goal, float))
+    lo, hi = search_bounds(start, goals)
+    trees = [_Tree(start), _Tree(goals)]
 
     def extend(tree: _Tree, target: np.ndarray) -> tuple[str, int]:
         nodes = tree.nodes
@@ -134,7 +139,7 @@ def rrt_connect(
             if status == "reached":
                 half_a, half_b = trees[0].branch(a), trees[1].branch(b)
                 path = half_a[::-1] + half_b[1:]
-                if np.allclose(path[0], q_goal):  # the trees were swapped an odd time
+                if not np.array_equal(path[0], start):  # the trees were swapped an odd time
                     path = path[::-1]
                 return np.array(path)
         trees.reverse()
