@@ -19,13 +19,15 @@ from arm_setups import (
 )
 
 from laserpick.behaviours import Behaviours, without_leftovers
+from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CARRIED_PADDING, CollisionChecker, carried_shape
-from laserpick.pipeline.grasp_choice import GraspSet
+from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.selection import group, score
-from laserpick.types import Grasp
+from laserpick.types import Grasp, Trajectory
 
 
 @pytest.fixture
@@ -68,6 +70,43 @@ def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
     assert np.abs(s.arm_qd).max() < 0.05
     assert tcp_pose(s.arm_q)[2, 3] > TABLE_TOP + 0.03, "it backed off upward"
     assert not s.gripper_closed
+
+
+def test_an_object_that_leaves_the_hand_as_the_lift_ends_is_said_to_have_slipped(robot):
+    """The mug is taken from the closed hand 50 ms before the full lift ends: the pick
+    judges the hold as the lift ends and says the object slipped out."""
+    name = "mug_1"
+    referee = Referee(robot)
+    perception = perceive(robot.capture(), point=referee.aim_point(name))
+    found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
+    assert isinstance(found, GraspSet), found
+    b = Behaviours(robot)
+    lifts: list[Trajectory] = []
+    run, wait = b.run, robot.wait
+
+    def counting_lifts(traj: Trajectory, what: str):
+        if what == "lifting":
+            lifts.append(traj)
+        return run(traj, what)
+
+    def away(m, d) -> None:
+        j = m.joint(f"obj/{name}")
+        d.qpos[j.qposadr[0] : j.qposadr[0] + 3] = [5.0, 5.0, 0.1]
+        d.qvel[j.dofadr[0] : j.dofadr[0] + 6] = 0.0
+
+    def taken_near_the_end(handle, timeout: float) -> str:
+        if len(lifts) == 2 and lifts[1] is not None:  # the full lift, after the re-grip's
+            full, lifts[1] = lifts[1], None
+            wait(handle, full.duration - 0.05)
+            robot.sim.call(away)
+        return wait(handle, timeout)
+
+    b.run = counting_lifts  # type: ignore[method-assign]
+    robot.wait = taken_near_the_end  # type: ignore[method-assign]
+    out = b.pick(found)
+    assert len(lifts) == 2 and lifts[1] is None, "taken during the full lift"
+    assert not out.ok and "slipped out of the hand while lifting" in out.failure.message
+    assert referee.position(name)[0] > 4.0
 
 
 def test_parts_of_the_object_the_segmentation_missed_leave_with_it():
