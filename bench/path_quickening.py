@@ -1,6 +1,6 @@
 """What the partial shortcuts of `pipeline/quicken.py` save, on recorded joint-space search
 problems: per problem, the timed duration of our search's path (RRT-Connect and vertex
-joins, as `plan.joint_path` had it before) and of the path `plan.joint_path` returns now,
+joins, as `joint_search.joint_path` had it before) and of the path it returns now,
 each timed at the speed its motion runs at (the carry's where the problem carries an
 object), and the wall-clock time each took. Both start from the same seed, so the search
 finds the same path, and the difference is the quickening alone.
@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from laserpick.pipeline.plan import joint_path, timed
+from laserpick.pipeline.joint_search import joint_path
+from laserpick.pipeline.motion_limits import timed
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import get_settings

@@ -1,7 +1,7 @@
 """Our RRT-Connect against OMPL's, side by side on recorded joint-space search problems.
 
 Record problems by running any bench with LASERPICK_RECORD_PLANS set: every search that
-`plan.joint_path` starts (the straight move blocked, both ends clear) is saved as one .npz
+`joint_search.joint_path` starts (the straight move blocked, both ends clear) is saved as one .npz
 (`laserpick.pipeline.plan_record`). Then each planner solves each problem once per seed,
 in turn (so both meet the same machine load), with the motion settings' sample budget:
 

@@ -40,8 +40,8 @@ from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
+from laserpick.pipeline.motion_limits import motion_limits
 from laserpick.pipeline.perceive import perceive
-from laserpick.pipeline.plan import motion_limits
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotz

@@ -14,7 +14,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import motion_limits, timed
+from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.timing import excess
 from laserpick.robot.sim.loop import DRIVE_STOP
 from laserpick.types import Trajectory

@@ -23,7 +23,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import timed
+from laserpick.pipeline.motion_limits import timed
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotx

@@ -13,22 +13,16 @@ from pydantic import ValidationError
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import body_frames
-from laserpick.pipeline import plan as plan_module
-from laserpick.pipeline import rrt
+from laserpick.pipeline import joint_search, rrt
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
     held_clear_of_arm,
     sphere_centres,
 )
+from laserpick.pipeline.joint_search import Searches, joint_path
 from laserpick.pipeline.lines import TURN_STEP, cartesian_line
-from laserpick.pipeline.plan import (
-    Searches,
-    joint_path,
-    plan_pick,
-    straight_lift,
-    transit_path,
-)
+from laserpick.pipeline.plan import plan_pick, straight_lift, transit_path
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut
@@ -474,8 +468,8 @@ def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch
         calls.append((float(a[0]), float(b[0])))
         return None
 
-    monkeypatch.setattr(plan_module, "joint_path", no_path)
-    searches = plan_module.Searches(max_failed=2)
+    monkeypatch.setattr(joint_search, "joint_path", no_path)
+    searches = joint_search.Searches(max_failed=2)
     home, ready, pre = np.zeros(6), np.full(6, 0.5), np.full(6, 1.0)
     s = get_settings().motion
     rng = np.random.default_rng(0)

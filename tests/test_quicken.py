@@ -10,7 +10,8 @@ from arm_poses import EMPTY, table, top_grasp
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.plan import joint_path, motion_limits, timed
+from laserpick.pipeline.joint_search import joint_path
+from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.quicken import quicken, run_time
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import get_settings

@@ -19,7 +19,8 @@ from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
 from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
-from laserpick.pipeline.plan import Searches, joint_path, plan_pick, transit_path
+from laserpick.pipeline.joint_search import Searches, joint_path
+from laserpick.pipeline.plan import plan_pick, transit_path
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene

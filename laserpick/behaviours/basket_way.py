@@ -12,7 +12,7 @@ from laserpick.behaviours.carry import holding_pose
 from laserpick.behaviours.drop_postures import drop_configurations
 from laserpick.behaviours.held import Held
 from laserpick.description import dims
-from laserpick.pipeline.plan import joint_path_via
+from laserpick.pipeline.joint_search import joint_path_via
 from laserpick.settings import Settings
 
 __all__ = ["BasketWay", "basket_way", "drop_postures_for", "path_to_a_drop"]

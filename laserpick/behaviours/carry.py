@@ -15,8 +15,9 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried
+from laserpick.pipeline.joint_search import joint_path_via
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import joint_path_via, timed
+from laserpick.pipeline.motion_limits import timed
 from laserpick.settings import Settings
 from laserpick.types import Failure
 

@@ -13,7 +13,7 @@ from laserpick.behaviours.laid_in import hand_turns, laid_in_candidates, scooter
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, held_at
-from laserpick.pipeline.plan import motion_limits
+from laserpick.pipeline.motion_limits import motion_limits
 from laserpick.pipeline.timing import Limits, straight_times
 from laserpick.settings import BehaviourSettings, MotionSettings, get_settings
 

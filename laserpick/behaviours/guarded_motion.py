@@ -20,8 +20,9 @@ from laserpick.behaviours.hand import wait_for_gripper
 from laserpick.behaviours.held import Held, WayIn
 from laserpick.behaviours.outcome import SEARCH, Outcome
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.joint_search import joint_path_via
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import joint_path_via, timed
+from laserpick.pipeline.motion_limits import timed
 from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure, Trajectory

@@ -23,7 +23,8 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import PickPlan, timed
+from laserpick.pipeline.motion_limits import timed
+from laserpick.pipeline.plan import PickPlan
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.types import Failure, Grasp, Trajectory
 

@@ -11,7 +11,7 @@ from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.first_plan import at_pose, at_rest
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import timed
+from laserpick.pipeline.motion_limits import timed
 
 __all__ = ["Stowing"]
 

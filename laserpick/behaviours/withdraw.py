@@ -11,7 +11,7 @@ from laserpick.behaviours.guarded_motion import GuardedMotion
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.plan import timed
+from laserpick.pipeline.motion_limits import timed
 from laserpick.transforms import rotz
 from laserpick.types import Failure
 

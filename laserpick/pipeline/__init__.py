@@ -15,10 +15,12 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.gpd import detect_grasps
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
+from laserpick.pipeline.joint_search import joint_path
 from laserpick.pipeline.laser_spots import detect_mark
 from laserpick.pipeline.lines import cartesian_line
+from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.perceive import Perception, perceive
-from laserpick.pipeline.plan import PickPlan, joint_path, motion_limits, plan_pick, timed
+from laserpick.pipeline.plan import PickPlan, plan_pick
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.reach import reachable
 from laserpick.pipeline.recall import Recalled, ViewMemory

@@ -18,7 +18,8 @@ from laserpick.description.dims import (
     UR5_UNSTOW_Q,
 )
 from laserpick.pipeline.grasp_choice import GraspSet
-from laserpick.pipeline.plan import PickPlan, Searches, plan_pick
+from laserpick.pipeline.joint_search import Searches
+from laserpick.pipeline.plan import PickPlan, plan_pick
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 

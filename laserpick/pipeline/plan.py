@@ -2,10 +2,9 @@
 
 Straight lines first: a straight joint-space move when it is clear, and straight Cartesian
 lines (`lines`) for the approach and the lift. When a joint-space move collides,
-RRT-Connect (Kuffner and LaValle 2000) searches around the obstacle: ours, shortened by
-random shortcuts (`rrt`), or OMPL's, shortened by OMPL's path simplifier (`ompl_search`;
-`MotionSettings.planner`). Every path is checked against a `CollisionChecker`, then
-time-parametrized within the motion limits of `MotionSettings` (`motion_limits`).
+RRT-Connect searches around the obstacle (`joint_search`). Every path is checked against a
+`CollisionChecker`, then time-parametrized within the motion limits of `MotionSettings`
+(`motion_limits`).
 
 Frames: TCP poses in `base` (m); joint angles in rad.
 """
@@ -14,7 +13,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -22,14 +21,11 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import GRIPPER_CAPSULES
 from laserpick.pipeline.collision import CollisionChecker, held_clear_of_arm
+from laserpick.pipeline.joint_search import Searches
 from laserpick.pipeline.lines import cartesian_line
-from laserpick.pipeline.ompl_search import ompl_connect
-from laserpick.pipeline.plan_record import record_search
-from laserpick.pipeline.quicken import quicken
+from laserpick.pipeline.motion_limits import timed
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
-from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.pipeline.smoothing import ClearFn
-from laserpick.pipeline.timing import Limits, time_parametrize
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Trajectory
 
@@ -37,190 +33,8 @@ from laserpick.types import Failure, Trajectory
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
 HAND_CONTACT_TOLERANCE = 0.004
-#: The search that tells whether a blocked leg had a way through unseen space: its samples
-#: (a way is found in about 0.05 s where there is one), and how many legs it tries.
-UNSEEN_SAMPLES = 300
-BLIND_LEGS = 3
 #: The gripper housing's capsule radius (m), the first of `GRIPPER_CAPSULES`.
 HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
-
-
-def joint_path(
-    q_start: np.ndarray,
-    q_goal: np.ndarray,
-    checker: CollisionChecker,
-    rng: np.random.Generator,
-    s: MotionSettings,
-    **kw,
-) -> np.ndarray | None:
-    """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
-    OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
-    shortcuts (`quicken`) where the timing says so. None at once when the start or the goal
-    is not clear: no edge can leave it, and the search would spend all its samples (seconds)
-    finding that out.
-
-    q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
-    else a search toward those that are clear (`_search`), which ends at the goal it reaches.
-    """
-    goals = np.atleast_2d(np.asarray(q_goal, float))
-    for goal in goals:
-        if checker.segment_ok(q_start, goal, **kw):
-            return np.array([q_start, goal], float)
-    ends_clear = checker.clearance_ok(np.vstack([q_start, goals]), **kw)
-    if not ends_clear[0] or not ends_clear[1:].any():
-        return None
-    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw)
-    if path is None or not s.quicken_paths:
-        return path
-    # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
-    carrying = kw.get("payload") is not None
-    quick = quicken(path, checker, rng, motion_limits(s, carrying=carrying), **kw)
-    quick = shortcut(quick, checker, rng, **kw)
-    # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
-    return min((path, quick), key=lambda p: timed(p, s, carrying=carrying).duration)
-
-
-def _search(
-    q_start: np.ndarray,
-    goals: np.ndarray,
-    checker: CollisionChecker,
-    rng: np.random.Generator,
-    s: MotionSettings,
-    kw: dict,
-) -> np.ndarray | None:
-    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first;
-    None where the search found none. Ours grows the goal side from every goal at once:
-    searched one after another, goals in a pocket spent the whole search each (a cereal
-    box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
-    its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
-    it searches them one after another."""
-    for goal in goals:
-        record_search(q_start, goal, checker, kw)
-    if s.planner == "ours":
-        path = rrt_connect(
-            q_start, goals, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
-        )
-        return None if path is None else shortcut(path, checker, rng, **kw)
-    budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
-    for goal in goals:
-        path = ompl_connect(q_start, goal, checker, rng, **budget, **kw)
-        if path is not None:
-            return path
-    return None
-
-
-def joint_path_via(
-    q_start: np.ndarray,
-    q_goal: np.ndarray,
-    checker: CollisionChecker,
-    rng: np.random.Generator,
-    s: MotionSettings,
-    via: Sequence[np.ndarray] = (),
-    **kw,
-) -> np.ndarray | None:
-    """`joint_path` to q_goal (6,) or to the first reached of goals (k, 6) rad; where it finds
-    none, through each configuration of `via` (6,) rad in turn: two shorter searches
-    instead of one long. None where no search found a path."""
-    path = joint_path(q_start, q_goal, checker, rng, s, **kw)
-    for q_via in via:
-        if path is not None:
-            break
-        first = joint_path(q_start, q_via, checker, rng, s, **kw)
-        second = joint_path(q_via, q_goal, checker, rng, s, **kw) if first is not None else None
-        path = None if second is None else np.vstack([first, second[1:]])
-    return path
-
-
-@dataclass
-class Searches:
-    """The joint-space searches of one pick, shared by the grasps it tries: a leg already
-    searched is reused (the leg from the stowed arm to the ready pose is the same for every
-    grasp), and failed searches are counted, so the pick can stop after `max_failed`. The
-    legs held to seen space that found no way are kept (`blocked`), to say why."""
-
-    max_failed: int
-    failed: int = 0
-    legs: dict[tuple[bytes, bytes], np.ndarray | None] = field(default_factory=dict)
-    blocked: list[tuple[np.ndarray, np.ndarray, CollisionChecker]] = field(default_factory=list)
-
-    def path(
-        self,
-        a: np.ndarray,
-        b: np.ndarray,
-        checker: CollisionChecker,
-        rng: np.random.Generator,
-        s: MotionSettings,
-        seen: bool = True,
-    ) -> np.ndarray | None:
-        """`joint_path` from a to b with the hand checked, searched once per pick; seen: with
-        the hand kept where the cameras saw through (`CollisionChecker.clearance_ok`), or
-        where it stands at either end."""
-        key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
-        if key not in self.legs:
-            known = checker.knowing(a, b) if seen else checker
-            self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
-            if self.legs[key] is None:
-                self.failed += 1
-                if seen and checker.frames:
-                    self.blocked.append((a, b, checker))
-        return self.legs[key]
-
-    def unseen_only(self, s: MotionSettings) -> bool:
-        """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
-        camera saw: the cameras' view, not what they saw, kept the arm from it (over their
-        heads, above a high table, their rays end on nothing in range). A short search
-        (UNSEEN_SAMPLES) with its own generator, so the pick's own searches stay as they
-        were; it only explains a failure, and such a way is never taken: an object seen in
-        part may reach into that space."""
-        rng = np.random.default_rng(0)
-        quick = s.model_copy(update={"rrt_max_samples": UNSEEN_SAMPLES})
-        return any(
-            joint_path(a, b, checker, rng, quick, hand=True) is not None
-            for a, b, checker in self.blocked[:BLIND_LEGS]
-        )
-
-    @property
-    def spent(self) -> bool:
-        return self.failed >= self.max_failed
-
-
-def motion_limits(
-    s: MotionSettings, *, carrying: bool = False, tcp_speed: float | None = None
-) -> Limits:
-    """The limits every move the arm runs keeps, from `s`: the joint speed, acceleration and
-    jerk, the TCP speed cap near people, lowered to `tcp_speed` (m/s) where given (the
-    approach, the lift; never raised), and while `carrying` the hand's turning cap
-    (`carry_turn_speed`)."""
-    return Limits(
-        speed=s.joint_speed,
-        accel=s.joint_accel,
-        jerk=s.joint_jerk,
-        tcp_speed=min(tcp_speed or s.tcp_speed, s.tcp_speed),
-        turn_speed=s.carry_turn_speed if carrying else None,
-    )
-
-
-def timed(
-    path: np.ndarray,
-    s: MotionSettings,
-    *,
-    tcp_speed: float | None = None,
-    carrying: bool = False,
-    gripper: tuple[tuple[int, str], ...] = (),
-    clear: Sequence[ClearFn | None] | ClearFn | None = None,
-) -> Trajectory:
-    """Time-parametrize a joint path within the motion limits of `s` (`motion_limits`,
-    `timing`): its corners blended, within `blend_tolerance` of the path, or
-    `blend_checked` where the legs' collision checks `clear` (one for all legs, or one per
-    leg) pass the blend."""
-    return time_parametrize(
-        path,
-        limits=motion_limits(s, carrying=carrying, tcp_speed=tcp_speed),
-        tolerance=s.blend_tolerance,
-        checked_tolerance=s.blend_checked,
-        clear=clear,
-        gripper=gripper,
-    )
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
 """Joint-space search problems saved for replay: with LASERPICK_RECORD_PLANS=DIR set, every
-search `plan.joint_path` starts (the straight move was blocked, both ends clear) is written
+search `joint_search.joint_path` starts (the straight move was blocked, both ends clear) is written
 to DIR as one .npz: the start and goal (rad), the collision checker's inputs (its cloud in
 `base`, m; margin and floor clearance, m; the depth frames and the arm's own space of its
 seen-space test) and the check's options. `bench/planners.py` replays them with each search.
