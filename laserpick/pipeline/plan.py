@@ -29,6 +29,16 @@ from laserpick.pipeline.smoothing import ClearFn
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Trajectory
 
+__all__ = [
+    "HAND_CONTACT_TOLERANCE",
+    "PickPlan",
+    "between_the_fingers",
+    "hand_fits",
+    "plan_pick",
+    "straight_lift",
+    "transit_path",
+]
+
 #: How far (m) the hand's spheres may overlap surrounding points at the grasp: the finger
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
