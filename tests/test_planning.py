@@ -22,11 +22,10 @@ from laserpick.pipeline.collision import (
 )
 from laserpick.pipeline.joint_search import Searches, joint_path
 from laserpick.pipeline.lines import TURN_STEP, cartesian_line
-from laserpick.pipeline.plan import plan_pick, straight_lift
+from laserpick.pipeline.plan import plan_pick, straight_lift, transit_path
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut
-from laserpick.pipeline.transit import transit_path
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.transforms import rotation_angle, rotx
 from laserpick.types import Failure, Grasp
@@ -272,7 +271,7 @@ def test_joint_path_from_a_blocked_start_gives_up_without_searching():
 
     checker.clearance_ok = counting  # type: ignore[method-assign]
     assert joint_path(q0, q1, checker, np.random.default_rng(0), get_settings().motion) is None
-    assert len(checked) == 2, "the straight segment and the start, no search"
+    assert len(checked) == 2, "the straight segment and the ends, no search"
 
 
 def test_plan_pick_approaches_straight_and_lifts_within_the_limits():

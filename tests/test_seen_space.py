@@ -15,16 +15,13 @@ from arm_poses import table
 
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline import joint_search
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
 from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches, joint_path
-from laserpick.pipeline.plan import plan_pick
-from laserpick.pipeline.reach import pregrasp_pose
+from laserpick.pipeline.plan import plan_pick, transit_path
 from laserpick.pipeline.selection import group
-from laserpick.pipeline.transit import transit_path
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.settings import get_settings
@@ -238,40 +235,3 @@ def test_a_pick_whose_ways_all_pass_unseen_space_says_so(world):
     assert isinstance(plan, Failure) and chosen is None and tried == 1
     assert plan.message.startswith("No collision-free path to this grasp was found")
     assert plan.message.endswith(UNSEEN_WAYS)
-
-
-def test_a_pick_searches_the_ways_to_its_best_grasps_at_once(world, monkeypatch):
-    """The first grasp, beside the table, has no way through seen space; the second has one
-    that only a search finds. The pick searches toward the first alone briefly
-    (`BEST_ALONE`), then toward both pre-grasps at once, and takes the second, its way held
-    to seen space knowing where the arm stands at that pre-grasp (not at the first's).
-    Searched one grasp at a time, each has a search of its own."""
-    searched: list[int] = []
-    search = joint_search.rrt_connect
-
-    def counting(q0, goals, *args, **kw):
-        searched.append(len(np.atleast_2d(goals)))
-        return search(q0, goals, *args, **kw)
-
-    monkeypatch.setattr(joint_search, "rrt_connect", counting)
-    grasps = []
-    for x, y, z in ((1.40, -0.75, 0.80), (1.50, -0.55, 0.65)):
-        pose = tcp_pose(READY)
-        pose[:3, 3] = x, y, z
-        grasps.append(Grasp(pose=pose, width=0.05, ik=ik_tcp(pose, READY)[0]))
-    middles = np.array([g.pose[:3, 3] for g in grasps])
-    found = GraspSet(group(grasps), (), world, world, middles, "gpd")
-    for together, searches in ((2, [1, 2]), (1, [1, 1])):
-        s = get_settings().motion.model_copy(update={"grasps_searched_together": together})
-        searched.clear()
-        # Generator 1: the way to the second is found in about 15 of 16 searches.
-        plan, chosen, tried = plan_first(found, READY, np.random.default_rng(1), grasps, s)
-        assert not isinstance(plan, Failure), plan
-        assert np.array_equal(chosen.pose, grasps[1].pose) and tried == 2
-        assert searched == searches
-    pres = np.array([pregrasp_pose(g.pose, s.approach_distance) for g in grasps])
-    pres = np.array([ik_tcp(T, g.ik)[0] for T, g in zip(pres, grasps, strict=True)])
-    route, _ = transit_path(READY, pres, world, np.random.default_rng(1), s, Searches(6))
-    assert np.array_equal(route[-1], pres[1])
-    known = world.knowing(READY, pres[1])
-    assert all(known.segment_ok(a, b, seen=True) for a, b in itertools.pairwise(route))

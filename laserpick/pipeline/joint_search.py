@@ -23,15 +23,12 @@ from laserpick.pipeline.quicken import quicken
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import MotionSettings
 
-__all__ = ["BEST_ALONE", "BLIND_LEGS", "UNSEEN_SAMPLES", "Searches", "joint_path", "joint_path_via"]
+__all__ = ["BLIND_LEGS", "UNSEEN_SAMPLES", "Searches", "joint_path", "joint_path_via"]
 
 #: The search that tells whether a blocked leg had a way through unseen space: its samples
 #: (a way is found in about 0.05 s where there is one), and how many legs it tries.
 UNSEEN_SAMPLES = 300
 BLIND_LEGS = 3
-#: A leg toward several ends searches toward the first alone for this many samples (about
-#: 1 s), before all: most legs that have a way find it so, and the pick keeps its best grasp.
-BEST_ALONE = 500
 
 
 def joint_path(
@@ -40,7 +37,6 @@ def joint_path(
     checker: CollisionChecker,
     rng: np.random.Generator,
     s: MotionSettings,
-    goal_checkers: Sequence[CollisionChecker] | None = None,
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
@@ -51,29 +47,16 @@ def joint_path(
 
     q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
     else a search toward those that are clear (`_search`), which ends at the goal it reaches.
-    goal_checkers: a check for each goal, which a path ending there keeps (a leg held to
-    seen space knows where the arm stands at its ends: `CollisionChecker.knowing`); then
-    `checker` is the start's, which every goal's path keeps too. Default: `checker` for all.
     """
     goals = np.atleast_2d(np.asarray(q_goal, float))
-    checks = list(goal_checkers) if goal_checkers is not None else [checker] * len(goals)
-    for goal, check in zip(goals, checks, strict=True):
-        if check.segment_ok(q_start, goal, **kw):
+    for goal in goals:
+        if checker.segment_ok(q_start, goal, **kw):
             return np.array([q_start, goal], float)
-    if not checker.clearance_ok(q_start, **kw)[0]:
+    ends_clear = checker.clearance_ok(np.vstack([q_start, goals]), **kw)
+    if not ends_clear[0] or not ends_clear[1:].any():
         return None
-    clear = [check.clearance_ok(goal, **kw)[0] for goal, check in zip(goals, checks, strict=True)]
-    if not any(clear):
-        return None
-    goals, checks = (
-        goals[np.array(clear, bool)],
-        [c for c, ok in zip(checks, clear, strict=True) if ok],
-    )
-    path = _search(q_start, goals, checker, checks, rng, s, kw)
-    if path is None:
-        return None
-    checker = checks[_goal_reached(path, goals)]  # what comes after keeps the goal's check
-    if not s.quicken_paths:
+    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw)
+    if path is None or not s.quicken_paths:
         return path
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
     carrying = kw.get("payload") is not None
@@ -87,46 +70,29 @@ def _search(
     q_start: np.ndarray,
     goals: np.ndarray,
     checker: CollisionChecker,
-    checks: Sequence[CollisionChecker],
     rng: np.random.Generator,
     s: MotionSettings,
     kw: dict,
 ) -> np.ndarray | None:
-    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first,
-    each with its check (`checks`; `checker` the start's); None where the search found
-    none. Ours grows the goal side from every goal at once: searched one after another,
-    goals in a pocket spent the whole search each (a cereal box's drops deep in the basket,
-    20 s a goal). OMPL's RRT-Connect adds a further goal to its goal tree only as that tree
-    grows, so a goal in a pocket keeps it from the others: it searches them one after
-    another."""
-    for goal, check in zip(goals, checks, strict=True):
-        record_search(q_start, goal, check, kw)
+    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first;
+    None where the search found none. Ours grows the goal side from every goal at once:
+    searched one after another, goals in a pocket spent the whole search each (a cereal
+    box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
+    its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
+    it searches them one after another."""
+    for goal in goals:
+        record_search(q_start, goal, checker, kw)
     if s.planner == "ours":
-        one = all(c is checker for c in checks)
         path = rrt_connect(
-            q_start,
-            goals,
-            checker,
-            rng,
-            step=s.rrt_step,
-            max_samples=s.rrt_max_samples,
-            goal_checkers=None if one else checks,
-            **kw,
+            q_start, goals, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
         )
-        if path is None:
-            return None
-        return shortcut(path, checks[_goal_reached(path, goals)], rng, **kw)
+        return None if path is None else shortcut(path, checker, rng, **kw)
     budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
-    for goal, check in zip(goals, checks, strict=True):
-        path = ompl_connect(q_start, goal, check, rng, **budget, **kw)
+    for goal in goals:
+        path = ompl_connect(q_start, goal, checker, rng, **budget, **kw)
         if path is not None:
             return path
     return None
-
-
-def _goal_reached(path: np.ndarray, goals: np.ndarray) -> int:
-    """The index of the goal among `goals` (k, 6) that `path` (K, 6) ends at (rad)."""
-    return int(np.flatnonzero((goals == path[-1]).all(axis=1))[0])
 
 
 def joint_path_via(
@@ -174,41 +140,16 @@ class Searches:
     ) -> np.ndarray | None:
         """`joint_path` from a to b with the hand checked, searched once per pick; seen: with
         the hand kept where the cameras saw through (`CollisionChecker.clearance_ok`), or
-        where it stands at either end. b (k, 6) gives several ends, best first: one search
-        toward the first reached, each end's path knowing only that end as where the arm
-        stands; a failed search counts once."""
-        goals = np.atleast_2d(np.asarray(b, float))
-        key = (np.asarray(a, float).tobytes(), goals.tobytes())
+        where it stands at either end."""
+        key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
         if key not in self.legs:
-            self.legs[key] = self._search(a, goals, checker, rng, s, seen)
+            known = checker.knowing(a, b) if seen else checker
+            self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:
                 self.failed += 1
                 if seen and checker.frames:
-                    self.blocked += [(a, goal, checker) for goal in goals]
+                    self.blocked.append((a, b, checker))
         return self.legs[key]
-
-    @staticmethod
-    def _search(
-        a: np.ndarray,
-        goals: np.ndarray,
-        checker: CollisionChecker,
-        rng: np.random.Generator,
-        s: MotionSettings,
-        seen: bool,
-    ) -> np.ndarray | None:
-        """The leg's `joint_path`, with the ends `knowing` where held to seen space; toward
-        several ends, the first alone for BEST_ALONE samples, then all together."""
-        kw = {"hand": True, "seen": seen}
-        if not seen:
-            return joint_path(a, goals, checker, rng, s, **kw)
-        if len(goals) == 1:
-            return joint_path(a, goals[0], checker.knowing(a, goals[0]), rng, s, **kw)
-        ends = [checker.knowing(a, goal) for goal in goals]
-        alone = s.model_copy(update={"rrt_max_samples": min(BEST_ALONE, s.rrt_max_samples)})
-        path = joint_path(a, goals[0], ends[0], rng, alone, **kw)
-        if path is not None:
-            return path
-        return joint_path(a, goals, checker.knowing(a), rng, s, goal_checkers=ends, **kw)
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no

@@ -11,6 +11,7 @@ Frames: TCP poses in `base` (m); joint angles in rad.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -25,28 +26,23 @@ from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.pipeline.reach import lifted_pose, pregrasp_pose
 from laserpick.pipeline.smoothing import ClearFn
-from laserpick.pipeline.transit import transit_path
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Trajectory
 
 __all__ = [
     "HAND_CONTACT_TOLERANCE",
-    "NO_PATH",
-    "GraspEnds",
     "PickPlan",
     "between_the_fingers",
-    "grasp_ends",
     "hand_fits",
     "plan_pick",
     "straight_lift",
+    "transit_path",
 ]
 
 #: How far (m) the hand's spheres may overlap surrounding points at the grasp: the finger
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
 HAND_CONTACT_TOLERANCE = 0.004
-#: Said where no way to a grasp's pre-grasp was found.
-NO_PATH = "No collision-free path to this grasp was found."
 #: The gripper housing's capsule radius (m), the first of `GRIPPER_CAPSULES`.
 HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
 
@@ -118,6 +114,88 @@ def hand_fits(q_grasp: np.ndarray, T_grasp: np.ndarray, surroundings: CollisionC
     return bool(beside.clearance_ok(q_grasp, hand=True, margin=-HAND_CONTACT_TOLERANCE)[0])
 
 
+def transit_path(
+    q_now: np.ndarray,
+    q_pre: np.ndarray,
+    world: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    searches: Searches,
+    via: Sequence[np.ndarray] = (),
+    unstow: np.ndarray | None = None,
+    standby: bool = False,
+    turn: np.ndarray | None = None,
+) -> tuple[np.ndarray, list[ClearFn]] | None:
+    """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`,
+    each leg searched once per pick (`searches`): through the way out of where the arm
+    rests (`_way_out`), or else through the first of `via` that the world shows clear. The
+    leg to the pre-grasp keeps the hand to space the cameras saw through; so do the legs
+    before it, but for the fixed way out of a rest pose. None when a leg finds no way; else
+    the waypoints and, for each segment between them, the check its leg was searched with
+    (for the blends of `timed`)."""
+    transit = None
+    checks: list[ClearFn] = []
+    clear = [q for q in via if world.clearance_ok(q)[0]]
+    out = _way_out(q_now, q_pre, world, clear, unstow, standby, turn)
+    fixed = out is not None
+    legs = [q_now, *(clear[:1] if out is None else out), q_pre]
+    for k, (a, b) in enumerate(itertools.pairwise(legs)):
+        # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
+        # beside the scooter and turns the elbow over above the cameras' view; the way from
+        # standing by rises from beside the scooter to the front (and turns the elbow over
+        # on to the unstow pose, for a grasp on that branch). Fixed ways of straight moves,
+        # not held to seen space. Only the leg to the grasp is: turning the elbow over on
+        # it swings the hand through space no camera saw, and finds no way.
+        seen = k == len(legs) - 2 or not fixed
+        leg = searches.path(a, b, world, rng, s, seen=seen)
+        if leg is None:
+            return None
+        transit = leg if transit is None else np.vstack([transit, leg[1:]])
+        checks += [_leg_check(world, a, b, seen)] * (len(leg) - 1)
+    return None if transit is None else (transit, checks)
+
+
+def _way_out(
+    q_now: np.ndarray,
+    q_pre: np.ndarray,
+    world: CollisionChecker,
+    clear: Sequence[np.ndarray],
+    unstow: np.ndarray | None,
+    standby: bool,
+    turn: np.ndarray | None,
+) -> list[np.ndarray] | None:
+    """The waypoints (rad) of the fixed way out of a rest pose to a pre-grasp q_pre: legs
+    of straight moves beside the scooter, where no camera sees, not held to seen space.
+    None when q_now is not a rest pose, or its way out is not clear in the `world`.
+
+    From the stowed pose (`unstow` given, `UR5_UNSTOW_Q`): through the unstow pose, then the
+    first `clear` ready pose, where the elbow turns over; where none is clear (a shelf's
+    boards fill both), for a pre-grasp on the other elbow branch, on to `turn` (standing
+    by's exit, `UR5_STANDBY_EXIT_Q`), the elbow up. From standing by (`standby`), the
+    elbow up: to the first clear ready pose, else through `unstow`, its exit
+    (`UR5_STANDBY_EXIT_Q`); for a pre-grasp on the other elbow branch, on to `turn` (the
+    unstow pose) as the stow goes. Either way the elbow turns over on the way out, not on
+    the leg held to seen space: turned there, the hand swings through space no camera saw,
+    and each grasp's search spent all its samples (a pill bottle on the bookshelf, 16 s)."""
+    if not standby:
+        if unstow is None or not world.clearance_ok(unstow)[0]:
+            return None
+        if not clear and turn is not None and q_pre[2] * unstow[2] < 0:
+            return [unstow, turn] if world.clearance_ok(turn)[0] else [unstow]
+        return [unstow, *clear[:1]]
+    if turn is not None and q_pre[2] * q_now[2] < 0 and world.clearance_ok(turn)[0]:
+        return [*clear[:1], turn]
+    if clear:
+        return [clear[0]]
+    return [unstow] if unstow is not None and world.clearance_ok(unstow)[0] else []
+
+
+def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool) -> ClearFn:
+    """The check `Searches.path` searched the leg from a to b with, for configurations."""
+    known = world.knowing(a, b) if seen else world
+    return lambda Q: known.clearance_ok(Q, hand=True, seen=seen)
+
+
 def plan_pick(
     q_now: np.ndarray,
     q_grasp: np.ndarray,
@@ -162,56 +240,14 @@ def plan_pick(
     """
     s = settings or get_settings().motion
     searches = searches or Searches(s.rrt_max_failed)
-    ends = grasp_ends(q_grasp, world, surroundings, s, check_hand, payload)
-    if isinstance(ends, Failure):
-        return ends
-    transit = transit_path(q_now, ends.q_pre, world, rng, s, searches, via, unstow, standby, turn)
-    if transit is None:
-        return Failure("ik_plan", NO_PATH)
-    return ends.plan(transit, s)
-
-
-@dataclass(frozen=True)
-class GraspEnds:
-    """A pick's motions at its grasp, each joint waypoints (K, 6) rad: the straight approach
-    from the pre-grasp `q_pre` (6,) to the grasp, the re-grip's first lift (`up`) and the
-    lift. What is left to plan is the way to the pre-grasp."""
-
-    q_pre: np.ndarray
-    approach: np.ndarray
-    up: np.ndarray
-    lift: np.ndarray
-
-    def plan(self, transit: tuple[np.ndarray, list[ClearFn]], s: MotionSettings) -> PickPlan:
-        """The pick plan with the way to the pre-grasp `transit` (from `transit_path`),
-        timed within the limits of `s`."""
-        return PickPlan(
-            transit=timed(transit[0], s, clear=transit[1]),
-            approach=timed(self.approach, s, tcp_speed=s.approach_speed),
-            regrip=timed(self.up, s, tcp_speed=s.approach_speed),
-            lift=timed(self.lift, s, tcp_speed=s.lift_speed),
-            q_grasp=self.approach[-1],
-            q_lifted=self.lift[-1],
-        )
-
-
-def grasp_ends(
-    q_grasp: np.ndarray,
-    world: CollisionChecker,
-    surroundings: CollisionChecker,
-    s: MotionSettings,
-    check_hand: bool = True,
-    payload: np.ndarray | None = None,
-) -> GraspEnds | Failure:
-    """The motions at the grasp whose IK solution is q_grasp (`plan_pick`, which says what
-    each is checked against), or the failure that rules the grasp out."""
     T_grasp = tcp_pose(q_grasp)
     if check_hand and not hand_fits(q_grasp, T_grasp, surroundings):
         return Failure("ik_plan", "The hand would hit something beside the object.")
     pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
     if len(pre) == 0:
         return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
-    approach = cartesian_line(pre[0], T_grasp, s.cartesian_step)
+    q_pre = pre[0]
+    approach = cartesian_line(q_pre, T_grasp, s.cartesian_step)
     if approach is None or not world.clearance_ok(approach, hand=False).all():
         return Failure("ik_plan", "The straight approach to this grasp is blocked.")
     approach[-1] = q_grasp
@@ -219,4 +255,14 @@ def grasp_ends(
     lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
     if lift is None:
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
-    return GraspEnds(pre[0], approach, up, lift)
+    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby, turn)
+    if transit is None:
+        return Failure("ik_plan", "No collision-free path to this grasp was found.")
+    return PickPlan(
+        transit=timed(transit[0], s, clear=transit[1]),
+        approach=timed(approach, s, tcp_speed=s.approach_speed),
+        regrip=timed(up, s, tcp_speed=s.approach_speed),
+        lift=timed(lift, s, tcp_speed=s.lift_speed),
+        q_grasp=q_grasp,
+        q_lifted=lift[-1],
+    )

@@ -8,7 +8,6 @@ Frames: joint angles in rad.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -68,19 +67,12 @@ def shortcut(
 
 class _Tree:
     """One tree of the search, or a forest of trees grown together: its nodes (rad), each
-    one's parent (-1: a root) and root, how many of its steps were blocked, and the check
-    each root's edges take (`checkers`, one per root)."""
+    one's parent (-1: a root), and how many of its steps were blocked."""
 
-    def __init__(self, roots: np.ndarray, checkers: Sequence[CollisionChecker]) -> None:
+    def __init__(self, roots: np.ndarray) -> None:
         self.nodes = list(np.atleast_2d(roots))
         self.parents = [-1] * len(self.nodes)
-        self.roots = list(range(len(self.nodes)))
-        self.checkers = checkers
         self.blocked = 0
-
-    def checker(self, index: int) -> CollisionChecker:
-        """The check of edges that leave node `index`: its root's."""
-        return self.checkers[self.roots[index]]
 
     def in_pocket(self, traps: int | None) -> bool:
         """Whether it is still under POCKET_NODES nodes after `traps` blocked steps (None:
@@ -105,7 +97,6 @@ def rrt_connect(
     step: float = 0.3,
     max_samples: int = 2000,
     pocket_traps: int | None = POCKET_TRAPS,
-    goal_checkers: Sequence[CollisionChecker] | None = None,
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
@@ -114,15 +105,12 @@ def rrt_connect(
     steps of at most `step` rad (largest joint); each new edge is collision-checked. A tree
     still small after `pocket_traps` blocked steps takes shorter ones (POCKET_TRAPS; None:
     never). q_goal (k, 6) gives k goals: the goal side grows from all of them at once, and
-    the path ends at the one it reached first. goal_checkers: one check per goal for the
-    edges of the tree grown from it (default: `checker`, which checks the start's tree),
-    each passing all that `checker` passes (it knows more of where the arm stands: the
-    trees may meet by the start's check); a path to goal j is then clear by goal j's.
+    the path ends at the one it reached first.
     """
     start = np.asarray(q_start, float)
     goals = np.atleast_2d(np.asarray(q_goal, float))
     lo, hi = search_bounds(start, goals)
-    trees = [_Tree(start, [checker]), _Tree(goals, goal_checkers or [checker] * len(goals))]
+    trees = [_Tree(start), _Tree(goals)]
 
     def extend(tree: _Tree, target: np.ndarray) -> tuple[str, int]:
         nodes = tree.nodes
@@ -132,12 +120,11 @@ def rrt_connect(
         reach = step * POCKET_STEP if tree.in_pocket(pocket_traps) else step
         reached = span <= reach
         q_new = target if reached else nodes[near] + delta * (reach / span)
-        if not tree.checker(near).segment_ok(nodes[near], q_new, **kw):
+        if not checker.segment_ok(nodes[near], q_new, **kw):
             tree.blocked += 1
             return "trapped", near
         nodes.append(q_new)
         tree.parents.append(near)
-        tree.roots.append(tree.roots[near])
         return ("reached" if reached else "advanced"), len(nodes) - 1
 
     for _ in range(max_samples):

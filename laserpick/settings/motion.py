@@ -145,14 +145,6 @@ class MotionSettings(BaseModel):
         description="Failed joint-space searches in one pick before no more grasps are tried:"
         " each takes seconds, and a user should not wait minutes for a 'no'. Ours.",
     )
-    grasps_searched_together: int = Field(
-        3,
-        ge=1,
-        description="Grasps, best first, whose pre-grasps one search looks for a way to at"
-        " once where the best has no straight way, taking the first it reaches: one by one,"
-        " a grasp with no way spent the whole search (2000 samples, 4 s) before the next"
-        " was tried. Ours, as the basket's `drop_tries`.",
-    )
     place_below: float = Field(
         0.02,
         ge=0,
