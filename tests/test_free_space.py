@@ -9,7 +9,9 @@ import numpy as np
 from laserpick.description import dims
 from laserpick.pipeline.collision import carried_shape
 from laserpick.pipeline.free_space import (
+    AT_ONCE_MAX,
     OBJECT_SPAN_MAX,
+    ONE_BY_ONE,
     beyond_view,
     finger_probes,
     fingers_seen_free,
@@ -116,6 +118,22 @@ def test_several_frames_free_a_point_where_any_one_of_them_does():
     assert alone.any(axis=0).sum() > alone[0].sum() > 0  # the later frames free some more
     assert (seen_free(points, frames, tol) == alone.any(axis=0)).all()
     assert not seen_free(points, [], tol).any()
+
+
+def test_many_frames_asked_at_once_free_what_each_alone_frees():
+    """Past the first ONE_BY_ONE frames, the rest are asked at once where the points left
+    are few (`AT_ONCE_MAX`): a point is free exactly where one frame, asked alone, sees past
+    it, however many points are asked and whichever way they are."""
+    looks = [BOX_CENTRE + [dx, dy, 0.0] for dx in (-0.2, 0.0, 0.2) for dy in (-0.3, 0.0, 0.3)]
+    frames = [_frame(box=k % 2 == 0, look_at=at) for k, at in enumerate(looks)]
+    assert len(frames) > ONE_BY_ONE
+    rng = np.random.default_rng(1)
+    for n in (50, AT_ONCE_MAX):  # asked at once; too many, asked one frame after another
+        points = BOX_CENTRE + rng.uniform(-0.5, 0.5, (n, 3))
+        tol = rng.uniform(0.0, 0.03, n)
+        alone = np.array([seen_free(points, [f], tol) for f in frames])
+        assert alone[ONE_BY_ONE:].any(axis=0).sum() > alone[:ONE_BY_ONE].any(axis=0).sum() / 10
+        assert (seen_free(points, frames, tol) == alone.any(axis=0)).all()
 
 
 def test_a_finger_in_the_box_unseen_back_is_refused_one_beside_it_is_not():

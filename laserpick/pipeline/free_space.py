@@ -12,6 +12,7 @@ Frames: points in `base` (m); each DepthFrame carries its pose in `base` and its
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 
 import numpy as np
@@ -60,16 +61,76 @@ def seen_free(
     points = np.asarray(points, np.float64).reshape(-1, 3)
     tolerance = np.broadcast_to(np.asarray(tolerance, np.float64), (len(points),))
     free = np.zeros(len(points), bool)
-    # Each frame is asked only about the points no earlier frame saw past: the kitchen keeps
-    # 45 frames, and most probes are seen free by the first few.
+    # The first frames one by one, each asked only about the points no earlier frame saw
+    # past (most probes are seen free by the first few); the rest all at once: the kitchen
+    # keeps 45 frames, and asked of each in turn, the points no camera saw past took 70 %
+    # of a search held to seen space (a failed one: 5.3 s, against 3.8 s so).
     todo = np.arange(len(points))
-    for f in frames:
+    for k, f in enumerate(frames):
         if not len(todo):
+            break
+        if k >= ONE_BY_ONE and len(todo) * (len(frames) - k) <= AT_ONCE_MAX:
+            stack = _stack(frames[ONE_BY_ONE:])
+            free[todo] = stack.seen_past(points[todo], tolerance[todo], k - ONE_BY_ONE)
             break
         i, reading, z = _reading(points[todo], f)
         free[todo[i[reading > z + tolerance[todo[i]]]]] = True
         todo = todo[~free[todo]]
     return free
+
+
+class _FrameStack:
+    """Depth frames asked all at once: their intrinsics (F, 3, 3) and poses in `base`
+    (F, 4, 4) stacked; their images (H, W; m) read frame by frame, not copied."""
+
+    def __init__(self, frames: Sequence[DepthFrame]) -> None:
+        self.frames = tuple(frames)  # kept, so that the ids that key the cache stay theirs
+        self.K = np.array([f.K for f in frames], np.float64)
+        self.T = np.array([f.T_base_cam for f in frames], np.float64)
+        self.size = np.array([f.depth.shape for f in frames])  # (F, 2): h, w
+
+    def seen_past(self, points: np.ndarray, tolerance: np.ndarray, first: int = 0) -> np.ndarray:
+        """(N,) `seen_free` of points (N, 3) (m, `base`) with `tolerance` (N,) (m) in these
+        frames from the `first` on: the same projection as `_reading`, all frames in one
+        product; then each frame's image read where points not yet seen past fall in it."""
+        K, T, size = self.K[first:], self.T[first:], self.size[first:]
+        q = (points[None] - T[:, None, :3, 3]) @ T[:, :3, :3]  # (F, N, 3)
+        front = q[..., 2] > MIN_RANGE
+        z = np.where(front, q[..., 2], 1.0)
+        u = np.rint(K[:, None, 0, 0] * q[..., 0] / z + K[:, None, 0, 2]).astype(np.int64)
+        v = np.rint(K[:, None, 1, 1] * q[..., 1] / z + K[:, None, 1, 2]).astype(np.int64)
+        h, w = size[:, :1], size[:, 1:]
+        inside = front & (u >= 0) & (u < w) & (v >= 0) & (v < h)
+        free = np.zeros(len(points), bool)
+        for f in np.flatnonzero(inside.any(axis=1)):
+            n = np.flatnonzero(inside[f] & ~free)
+            reading = self.frames[first + f].depth[v[f, n], u[f, n]]
+            free[n[reading > q[f, n, 2] + tolerance[n]]] = True
+        return free
+
+
+#: The frames `seen_free` asks one by one before it asks the rest at once, where they and
+#: the points left are at most AT_ONCE_MAX pairs (more, the one product costs more than the
+#: frames one by one, which see most points free early).
+ONE_BY_ONE = 4
+AT_ONCE_MAX = 100_000
+#: Stacks kept: a pick asks of its capture's frames (with the views from the way in)
+#: thousands of times, and grasp detection of its own.
+STACKS_KEPT = 2
+_STACKS: dict[tuple[int, ...], _FrameStack] = {}
+_STACKS_LOCK = threading.Lock()
+
+
+def _stack(frames: Sequence[DepthFrame]) -> _FrameStack:
+    """The frames' intrinsics and poses stacked (`_FrameStack`) once while they are asked:
+    the last STACKS_KEPT are kept (the carry's search ahead asks from its own thread)."""
+    key = tuple(map(id, frames))
+    with _STACKS_LOCK:
+        stack = _STACKS.pop(key, None) or _FrameStack(frames)
+        _STACKS[key] = stack
+        while len(_STACKS) > STACKS_KEPT:
+            del _STACKS[next(iter(_STACKS))]
+    return stack
 
 
 def hidden(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -> np.ndarray:
