@@ -36,6 +36,14 @@ MIN_RANGE = 0.1
 VIEW_EDGE_PX = 8
 #: Fewest target points at the view's edge for the object to count as cut off by it.
 CUT_MIN_POINTS = 5
+#: The frames `seen_free` asks one by one before it asks the rest at once, where they and
+#: the points left are at most AT_ONCE_MAX pairs (more, the one product costs more than the
+#: frames one by one, which see most points free early).
+ONE_BY_ONE = 4
+AT_ONCE_MAX = 100_000
+#: Stacks kept: a pick asks of its capture's frames (with the views from the way in)
+#: thousands of times, and grasp detection of its own.
+STACKS_KEPT = 2
 #: The longest (m) an object the hand carries is taken to be where the cameras' view cut it
 #: off (the kitchen's longest, the juice bottle, is 20.6 cm).
 OBJECT_SPAN_MAX = 0.25
@@ -109,14 +117,6 @@ class _FrameStack:
         return free
 
 
-#: The frames `seen_free` asks one by one before it asks the rest at once, where they and
-#: the points left are at most AT_ONCE_MAX pairs (more, the one product costs more than the
-#: frames one by one, which see most points free early).
-ONE_BY_ONE = 4
-AT_ONCE_MAX = 100_000
-#: Stacks kept: a pick asks of its capture's frames (with the views from the way in)
-#: thousands of times, and grasp detection of its own.
-STACKS_KEPT = 2
 _STACKS: dict[tuple[int, ...], _FrameStack] = {}
 _STACKS_LOCK = threading.Lock()
 
