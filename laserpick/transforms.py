@@ -124,11 +124,15 @@ def pinhole_project(
     """Pixel coordinates (N, 2) (u, v), depths along the optical axis (N,) (m) and a mask of
     the points in front of the lens (depth > `near`, m) of `points` (N, 3) in the frame
     `T_world_cam` (4x4, OpenCV optical frame: x right, y down, z forward) is given in. The
-    pixel coordinates of the points not in front are meaningless."""
+    pixel coordinates of the points not in front are meaningless. Stacked cameras, K
+    (F, 3, 3) and T_world_cam (F, 4, 4), give each of these for each: (F, N, 2), (F, N)."""
     P = np.asarray(points, dtype=float).reshape(-1, 3)
-    R, t = T_world_cam[:3, :3], T_world_cam[:3, 3]
+    R, t = T_world_cam[..., :3, :3], T_world_cam[..., None, :3, 3]
     q = (P - t) @ R  # R^T (p - t) per row: the points in the optical frame
-    front = q[:, 2] > near
-    z = np.where(front, q[:, 2], 1.0)
-    uv = np.stack([K[0, 0] * q[:, 0] / z + K[0, 2], K[1, 1] * q[:, 1] / z + K[1, 2]], axis=1)
-    return uv, q[:, 2], front
+    front = q[..., 2] > near
+    z = np.where(front, q[..., 2], 1.0)
+    K = K[..., None, :, :]  # one camera's intrinsics for all its points
+    u = K[..., 0, 0] * q[..., 0] / z + K[..., 0, 2]
+    v = K[..., 1, 1] * q[..., 1] / z + K[..., 1, 2]
+    uv = np.stack([u, v], axis=-1)
+    return uv, q[..., 2], front

@@ -99,21 +99,17 @@ class _FrameStack:
 
     def seen_past(self, points: np.ndarray, tolerance: np.ndarray, first: int = 0) -> np.ndarray:
         """(N,) `seen_free` of points (N, 3) (m, `base`) with `tolerance` (N,) (m) in these
-        frames from the `first` on: the same projection as `_reading`, all frames in one
-        product; then each frame's image read where points not yet seen past fall in it."""
-        K, T, size = self.K[first:], self.T[first:], self.size[first:]
-        q = (points[None] - T[:, None, :3, 3]) @ T[:, :3, :3]  # (F, N, 3)
-        front = q[..., 2] > MIN_RANGE
-        z = np.where(front, q[..., 2], 1.0)
-        u = np.rint(K[:, None, 0, 0] * q[..., 0] / z + K[:, None, 0, 2]).astype(np.int64)
-        v = np.rint(K[:, None, 1, 1] * q[..., 1] / z + K[:, None, 1, 2]).astype(np.int64)
-        h, w = size[:, :1], size[:, 1:]
-        inside = front & (u >= 0) & (u < w) & (v >= 0) & (v < h)
+        frames from the `first` on: `_reading`'s projection, all frames in one product; then
+        each frame's image read where points not yet seen past fall in it."""
+        uv, z, ahead = pinhole_project(points, self.K[first:], self.T[first:], MIN_RANGE)
+        u, v = np.moveaxis(np.rint(uv).astype(np.int64), -1, 0)  # each (F, N)
+        h, w = self.size[first:, :1], self.size[first:, 1:]
+        inside = ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h)
         free = np.zeros(len(points), bool)
         for f in np.flatnonzero(inside.any(axis=1)):
             n = np.flatnonzero(inside[f] & ~free)
             reading = self.frames[first + f].depth[v[f, n], u[f, n]]
-            free[n[reading > q[f, n, 2] + tolerance[n]]] = True
+            free[n[reading > z[f, n] + tolerance[n]]] = True
         return free
 
 
