@@ -9,6 +9,7 @@ import numpy as np
 from laserpick.description import dims
 from laserpick.pipeline.collision import carried_shape
 from laserpick.pipeline.free_space import (
+    ALL_AT_ONCE_MAX,
     AT_ONCE_MAX,
     OBJECT_SPAN_MAX,
     ONE_BY_ONE,
@@ -122,9 +123,10 @@ def test_several_frames_free_a_point_where_any_one_of_them_does():
 
 
 def test_many_frames_asked_at_once_free_what_each_alone_frees():
-    """Past the first ONE_BY_ONE frames, the rest are asked at once where the points left
-    are few (`AT_ONCE_MAX`): a point is free exactly where one frame, asked alone, sees past
-    it, however many points are asked and whichever way they are."""
+    """Few points are asked of all frames at once (`ALL_AT_ONCE_MAX`); many, of the first
+    ONE_BY_ONE frames one by one, then of the rest at once where the points left are few
+    (`AT_ONCE_MAX`): a point is free exactly where one frame, asked alone, sees past it,
+    however many points are asked and whichever way they are."""
     # The first frames from the front, the rest from either side, which see into the box's
     # shadow as the first do not.
     eyes = [CAMERA + [dx, 0.0, 0.0] for dx in (0.0, -0.05, -0.1, -0.15)]
@@ -134,8 +136,9 @@ def test_many_frames_asked_at_once_free_what_each_alone_frees():
     rng = np.random.default_rng(1)
     around = ([-0.2, -0.2, -0.09], [0.2, 0.2, 0.15])
     behind = ([0.04, -0.03, -0.09], [0.2, 0.03, 0.09])  # in the shadow of the front frames
-    # Few points, asked at once after the first frames; too many, one frame after another
-    # until few are left, then the frames after that at once.
+    # Few points, asked of all frames at once; too many, one frame after another until few
+    # are left, then the frames after that at once.
+    assert 50 * len(frames) <= ALL_AT_ONCE_MAX < AT_ONCE_MAX * len(frames)
     for n, (lo, hi) in ((50, around), (AT_ONCE_MAX, behind)):
         points = BOX_CENTRE + rng.uniform(lo, hi, (n, 3))
         tol = rng.uniform(0.0, 0.03, n)
