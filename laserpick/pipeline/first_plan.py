@@ -6,6 +6,7 @@ radians.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from laserpick.description.dims import (
 )
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
-from laserpick.pipeline.plan import PickPlan, plan_pick
+from laserpick.pipeline.plan import NO_WAY, PickPlan, plan_pick
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
@@ -62,28 +63,72 @@ def plan_first(
     by, through its exit where no ready pose is clear. From either, the way to the ready
     pose is a fixed way beside the scooter (`plan.transit_path`).
     The hand is checked at the grasp only for vertical grasps: GPD and EL-E's sweep tested
-    it there already. Returns the plan (or the last failure, which says so when ways
-    through space the cameras did not see were left untaken), its grasp and how many grasps
-    were tried.
+    it there already.
+
+    Where the grasps run out within the searches' budget and some found no way to their
+    pre-grasp, those are planned once more, best first, through the high ready pose first
+    and with the failed legs searched anew: a search held to seen space finds a narrow way
+    on some draws and not others, and a pick with one grasp left had one search between it
+    and "no". Returns the plan (or the last failure, which says so when ways through space
+    the cameras did not see were left untaken), its grasp and its place in the order (or
+    how many grasps were tried).
     """
     s = settings or get_settings().motion
-    at_ready = at_pose(q_now, UR5_READY_Q)
-    via = () if at_ready else (UR5_READY_Q, UR5_HIGH_READY_Q)
-    stowed = at_pose(q_now, UR5_HOME_Q)
-    standby = at_pose(q_now, UR5_STANDBY_Q)
-    plan: PickPlan | Failure = Failure("ik_plan", "There is no grasp to plan for.")
+    grasps = list(found.ordered() if order is None else order)
+    via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     searches = Searches(s.rrt_max_failed)
-    carried = found.carried
-    tried, refused = 0, None
-    for grasp in found.ordered() if order is None else order:
-        tried += 1
+    turn = _plan_in_turn(found, grasps, q_now, rng, s, via, searches, admit)
+    tried = turn.tried
+    if turn.grasp is None and turn.no_way and not searches.spent:
+        searches.forget_failed()
+        again = (UR5_HIGH_READY_Q, *via[:1])
+        turn = _plan_in_turn(found, turn.no_way, q_now, rng, s, again, searches)
+    if turn.grasp is not None:
+        place = next(k for k, g in enumerate(grasps, 1) if g is turn.grasp)
+        return turn.plan, turn.grasp, place
+    plan = turn.plan
+    if isinstance(plan, Failure) and not turn.refused and searches.unseen_only(s):
+        plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
+    return plan, None, tried
+
+
+@dataclass
+class _Turn:
+    """One pass of `plan_first` over its grasps: the plan (or the last failure) and its
+    grasp, how many grasps were tried, whether the last failure was `admit`'s refusal, and
+    the grasps whose transit found no way (`NO_WAY`), best first."""
+
+    plan: PickPlan | Failure
+    grasp: Grasp | None = None
+    tried: int = 0
+    refused: bool = False
+    no_way: list[Grasp] = field(default_factory=list)
+
+
+def _plan_in_turn(
+    found: GraspSet,
+    grasps: Sequence[Grasp],
+    q_now: np.ndarray,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    via: Sequence[np.ndarray],
+    searches: Searches,
+    admit: Callable[[Grasp], Failure | None] | None = None,
+) -> _Turn:
+    """`plan_pick` for each of `grasps` in turn, through the first clear pose of `via`,
+    until one plans or the `searches` are spent."""
+    stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
+    turn = _Turn(Failure("ik_plan", "There is no grasp to plan for."))
+    for grasp in grasps:
+        turn.tried += 1
         if grasp.ik is None:
             raise ValueError("plan_first needs grasps from the reachability filter")
         refused = admit(grasp) if admit is not None else None
+        turn.refused = refused is not None
         if refused is not None:
-            plan = refused
+            turn.plan = refused
             continue
-        plan = plan_pick(
+        turn.plan = plan_pick(
             q_now,
             grasp.ik,
             found.world,
@@ -96,14 +141,15 @@ def plan_first(
             unstow=UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
             standby=standby,
             turn=UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
-            payload=grasp.in_hand(carried),
+            payload=grasp.in_hand(found.carried),
         )
-        if not isinstance(plan, Failure):
-            return plan, grasp, tried
+        if not isinstance(turn.plan, Failure):
+            turn.grasp = grasp
+            return turn
+        if turn.plan.message == NO_WAY:
+            turn.no_way.append(grasp)
         if searches.spent:
             msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            plan = Failure("ik_plan", msg)
+            turn.plan = Failure("ik_plan", msg)
             break
-    if isinstance(plan, Failure) and plan is not refused and searches.unseen_only(s):
-        plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
-    return plan, None, tried
+    return turn

@@ -165,6 +165,11 @@ class Searches:
             for a, b, checker in self.blocked[:BLIND_LEGS]
         )
 
+    def forget_failed(self) -> None:
+        """Let the legs that found no way be searched again, with new draws; the failures
+        stay counted against `max_failed`."""
+        self.legs = {key: leg for key, leg in self.legs.items() if leg is not None}
+
     @property
     def spent(self) -> bool:
         return self.failed >= self.max_failed

@@ -31,6 +31,7 @@ from laserpick.types import Failure, Trajectory
 
 __all__ = [
     "HAND_CONTACT_TOLERANCE",
+    "NO_WAY",
     "PickPlan",
     "between_the_fingers",
     "hand_fits",
@@ -43,6 +44,8 @@ __all__ = [
 #: spheres' rounded ends reach the fingertips, which stop 2-3 mm above the support, and the
 #: support's points scatter by a few millimetres.
 HAND_CONTACT_TOLERANCE = 0.004
+#: Said when a pick's transit to its pre-grasp found no way (`plan_pick`).
+NO_WAY = "No collision-free path to this grasp was found."
 #: The gripper housing's capsule radius (m), the first of `GRIPPER_CAPSULES`.
 HOUSING_RADIUS = GRIPPER_CAPSULES[0][2]
 
@@ -257,7 +260,7 @@ def plan_pick(
         return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
     transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby, turn)
     if transit is None:
-        return Failure("ik_plan", "No collision-free path to this grasp was found.")
+        return Failure("ik_plan", NO_WAY)
     return PickPlan(
         transit=timed(transit[0], s, clear=transit[1]),
         approach=timed(approach, s, tcp_speed=s.approach_speed),
