@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from laserpick.bench.attempts import Attempt
-from laserpick.bench.parking import FLOOR_TURNS, PARK_FLOOR_REACH, parking_pose
+from laserpick.bench.parking import FLOOR_TURNS, PARK_FLOOR_REACH, parking_pose, spots_near
 from laserpick.bench.protocols.retries import IN_VIEW_ACROSS, RETRY_BACK, next_try
 from laserpick.bench.route_planning import (
     DRIVE_MARGIN,
@@ -150,6 +150,24 @@ def test_told_the_cameras_could_not_see_the_way_the_user_parks_the_object_nearer
         x, y, yaw = parking_pose(table, 0.0, table.levels[0], across=across)
         in_base = invert(planar_pose(x, y, yaw)) @ np.append(spot, 1.0)
         assert in_base[1] == pytest.approx(dims.ARM_MOUNT_POS[1] + across, abs=1e-9)
+
+
+def test_where_the_spot_asked_is_not_clear_the_user_parks_as_near_it_as_the_room_allows():
+    """With the arm standing by beside the scooter (its outline 10 cm wider on the right than
+    stowed), the spot 20 cm to the arm's left before the 108 cm table, asked for a second
+    try, brings the scooter's right side against the furniture beside it. The user parks
+    at the nearest spot that is clear instead: 10 cm across. Stowed, the spot asked is."""
+    kitchen = load_scene("kitchen", seed=1)
+    table = kitchen.surface("high_table")
+    others = [s for s in kitchen.surfaces if s.kind != "floor" and s.name != "high_table"]
+    stowed = Outline((-0.15, 1.30), (-0.68, 0.38))  # about the referee's, stowed
+    standing_by = Outline((-0.15, 1.32), (-0.78, 0.38))
+    spots = spots_near(table, 0.0, -0.05, table.levels[0], across=IN_VIEW_ACROSS)
+    assert np.allclose(spots[0], parking_pose(table, -0.05, table.levels[0], across=0.2))
+    assert parked_clear(spots[0], others, stowed)
+    first = next(k for k, spot in enumerate(spots) if parked_clear(spot, others, standing_by))
+    assert first > 0
+    assert np.allclose(spots[first], parking_pose(table, -0.05, table.levels[0], across=0.1))
 
 
 @pytest.mark.slow

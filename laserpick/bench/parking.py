@@ -53,6 +53,11 @@ FLOOR_TURNS = tuple(math.radians(a) for a in sorted(range(-165, 195, 15), key=ab
 #: object between a counter and two others may have a clear way in only 10-20 cm to a
 #: side.
 FLOOR_ACROSS = (0.0, 0.1, -0.1, 0.2, -0.2)
+#: (back, across) m the user shifts the spot they meant to park at before a surface, in the
+#: order tried, where it is not clear or no way leads there: a person parks as near it as
+#: the room allows. With the arm standing by beside the scooter (10 cm wider on the right
+#: than stowed), the spot 20 cm across asked for a second try at the 108 cm table was not.
+SURFACE_SHIFTS = ((0.0, 0.0), (0.0, -0.1), (0.0, 0.1), (0.1, 0.0), (0.1, -0.1), (0.1, 0.1))
 
 
 def parking_pose(
@@ -140,13 +145,10 @@ def park(
     `back` m farther back than at first and `across` m to the arm's left, and say whether
     the user parked there. Parked, the scooter may reach over only `works_at`: the surface,
     or the object on a floor it picks (None: a free spot on a floor). A floor may be driven
-    onto from any side: the user tries each of FLOOR_TURNS, the spot straight before the arm
-    and then a little to a side (FLOOR_ACROSS), until one parks clear of everything else and
-    leads there. Where none does and something that fell lies on the floor (`fallen`), the
-    user asks for it to be picked up and tries once more."""
-    floor = surface.kind == "floor"
-    ways = itertools.product(FLOOR_ACROSS, FLOOR_TURNS) if floor else [(0.0, 0.0)]
-    ways = [(across + a, turn) for a, turn in ways]
+    onto from any side. The user tries the spots `spots_near` gives in turn, until one parks
+    clear of everything else and a way leads there. Where none does and something that fell
+    lies on the floor (`fallen`), the user asks for it to be picked up and tries once more."""
+    spots = spots_near(surface, local_x, local_y, level, back, across)
     outline = outline or op.referee.outline()
     parked_at = () if works_at is None else (works_at,)
     for cleared in (False, True):
@@ -159,10 +161,7 @@ def park(
             log.info("the floor cleared of %s, which kept the user from parking", down)
         around = _scene_obstacles(op, scene)
         others = [a for a in around if a.name not in parked_at]
-        for across, turn in ways:
-            goal = parking_pose(
-                surface, local_y, level, local_x=local_x, turn=turn, back=back, across=across
-            )
+        for goal in spots:
             if np.linalg.norm(op.base_pose()[:2] - goal[:2]) < 0.03:
                 return True
             if not parked_clear(goal, others, outline):
@@ -171,6 +170,31 @@ def park(
             if plan is not None:
                 return follow(op, goal, *plan)
     return False
+
+
+def spots_near(
+    surface: Surface,
+    local_x: float,
+    local_y: float,
+    level: float,
+    back: float = 0.0,
+    across: float = 0.0,
+) -> list[np.ndarray]:
+    """The parking poses (x, y, yaw in `world`) the user tries, in order, to work at the spot
+    (local x, y: m in the surface's frame; level: its height), `back` m farther back and
+    `across` m to the arm's left (`parking_pose`): on a floor, each of FLOOR_TURNS with the
+    spot straight before the arm, then a little to a side (FLOOR_ACROSS); before a surface,
+    the spot asked, then near it (SURFACE_SHIFTS)."""
+    if surface.kind == "floor":
+        shifts = [(0.0, a, turn) for a, turn in itertools.product(FLOOR_ACROSS, FLOOR_TURNS)]
+    else:
+        shifts = [(b, a, 0.0) for b, a in SURFACE_SHIFTS]
+    return [
+        parking_pose(
+            surface, local_y, level, local_x=local_x, turn=turn, back=back + b, across=across + a
+        )
+        for b, a, turn in shifts
+    ]
 
 
 def fallen(scene: Scene, referee: Referee) -> list[str]:
