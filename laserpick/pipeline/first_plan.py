@@ -77,23 +77,23 @@ def plan_first(
     grasps = list(found.ordered() if order is None else order)
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     searches = Searches(s.rrt_max_failed)
-    turn = _plan_in_turn(found, grasps, q_now, rng, s, via, searches, admit)
-    tried = turn.tried
-    if turn.grasp is None and turn.no_way and not searches.spent:
+    first = _plan_in_order(found, grasps, q_now, rng, s, via, searches, admit)
+    last = first
+    if first.grasp is None and first.no_way and not searches.spent:
         searches.forget_failed()
         again = (UR5_HIGH_READY_Q, *via[:1])
-        turn = _plan_in_turn(found, turn.no_way, q_now, rng, s, again, searches)
-    if turn.grasp is not None:
-        place = next(k for k, g in enumerate(grasps, 1) if g is turn.grasp)
-        return turn.plan, turn.grasp, place
-    plan = turn.plan
-    if isinstance(plan, Failure) and not turn.refused and searches.unseen_only(s):
+        last = _plan_in_order(found, first.no_way, q_now, rng, s, again, searches)
+    if last.grasp is not None:
+        place = next(k for k, g in enumerate(grasps, 1) if g is last.grasp)
+        return last.plan, last.grasp, place
+    plan = last.plan
+    if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
         plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
-    return plan, None, tried
+    return plan, None, first.tried
 
 
 @dataclass
-class _Turn:
+class _Pass:
     """One pass of `plan_first` over its grasps: the plan (or the last failure) and its
     grasp, how many grasps were tried, whether the last failure was `admit`'s refusal, and
     the grasps whose transit found no way (`NO_WAY`), best first."""
@@ -105,7 +105,7 @@ class _Turn:
     no_way: list[Grasp] = field(default_factory=list)
 
 
-def _plan_in_turn(
+def _plan_in_order(
     found: GraspSet,
     grasps: Sequence[Grasp],
     q_now: np.ndarray,
@@ -114,21 +114,21 @@ def _plan_in_turn(
     via: Sequence[np.ndarray],
     searches: Searches,
     admit: Callable[[Grasp], Failure | None] | None = None,
-) -> _Turn:
+) -> _Pass:
     """`plan_pick` for each of `grasps` in turn, through the first clear pose of `via`,
     until one plans or the `searches` are spent."""
     stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
-    turn = _Turn(Failure("ik_plan", "There is no grasp to plan for."))
+    done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
     for grasp in grasps:
-        turn.tried += 1
+        done.tried += 1
         if grasp.ik is None:
             raise ValueError("plan_first needs grasps from the reachability filter")
         refused = admit(grasp) if admit is not None else None
-        turn.refused = refused is not None
+        done.refused = refused is not None
         if refused is not None:
-            turn.plan = refused
+            done.plan = refused
             continue
-        turn.plan = plan_pick(
+        done.plan = plan_pick(
             q_now,
             grasp.ik,
             found.world,
@@ -143,13 +143,13 @@ def _plan_in_turn(
             turn=UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
             payload=grasp.in_hand(found.carried),
         )
-        if not isinstance(turn.plan, Failure):
-            turn.grasp = grasp
-            return turn
-        if turn.plan.message == NO_WAY:
-            turn.no_way.append(grasp)
+        if not isinstance(done.plan, Failure):
+            done.grasp = grasp
+            return done
+        if done.plan.message == NO_WAY:
+            done.no_way.append(grasp)
         if searches.spent:
             msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            turn.plan = Failure("ik_plan", msg)
+            done.plan = Failure("ik_plan", msg)
             break
-    return turn
+    return done
