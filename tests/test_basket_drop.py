@@ -112,25 +112,44 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     assert min(passed) < 0.01
 
 
-def test_after_a_drop_with_both_ready_poses_filled_the_arm_stows_from_the_basket(robot):
-    """Parked at a shelf, whose boards fill both ready poses, the arm that has let go over
-    the basket folds away from there, rather than end with the object in the basket and no
-    way to ready; and stays there when the session then stands by."""
-    name = "mug_1"
+def _drop_among(robot, name: str, *clouds: np.ndarray):
+    """Pick `name`, then drop it in the basket as if `clouds` (m, `base`) stood around the
+    arm too; returns the behaviours and the referee, once the object has fallen."""
     b, referee = pick_object(robot, name)
     assert b.held is not None
-    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
-    filled = CollisionChecker(np.vstack([b.held.surroundings.points, board]))
-    assert not filled.clearance_ok(dims.UR5_READY_Q)[0]
-    assert not filled.clearance_ok(dims.UR5_HIGH_READY_Q)[0]
-    b.held = dataclasses.replace(b.held, surroundings=filled)
+    around = CollisionChecker(np.vstack([b.held.surroundings.points, *clouds]))
+    b.held = dataclasses.replace(b.held, surroundings=around)
     dropped = b.drop_in_basket()
     assert dropped.ok, dropped.failure
     robot.sleep(1.0)
     assert referee.in_basket(name)
+    return b, around
+
+
+def test_after_a_drop_the_arm_goes_from_the_basket_to_stand_by(robot):
+    """Parked at a shelf, whose boards fill both ready poses, the arm that has let go over
+    the basket goes from there to stand by for the next pick, beside the scooter: not
+    through ready, nor folded away, from where the next pick turns the elbow over on its
+    way out. The session's stand-by then leaves it there."""
+    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
+    b, around = _drop_among(robot, "mug_1", board)
+    assert not around.clearance_ok(dims.UR5_READY_Q)[0]
+    assert not around.clearance_ok(dims.UR5_HIGH_READY_Q)[0]
+    assert np.abs(robot.joint_state().q - dims.UR5_STANDBY_Q).max() < 0.05
+    assert b.stand_by().ok
+    assert np.abs(robot.joint_state().q - dims.UR5_STANDBY_Q).max() < 0.05
+
+
+def test_after_a_drop_with_no_way_to_stand_by_or_ready_the_arm_folds_away(robot):
+    """With the boards filling both ready poses and something standing where the arm
+    stands by (a bag hung on the scooter's side), the arm folds away from the basket, and
+    stays stowed when the session then stands by."""
+    board = table(1.06, x=(1.35, 1.95), y=(-0.6, 0.0))
+    hand = tcp_pose(dims.UR5_STANDBY_Q)[:3, 3]
+    bag = hand + np.random.default_rng(0).uniform(-0.06, 0.06, (400, 3))
+    b, around = _drop_among(robot, "mug_1", board, bag)
+    assert not around.clearance_ok(dims.UR5_STANDBY_Q)[0]
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
-    # The session stands by after a drop; from the stowed pose that would turn the elbow over
-    # again, so an arm at rest stays there.
     assert b.stand_by().ok
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
 

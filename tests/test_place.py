@@ -59,11 +59,11 @@ def borne_from_below(robot: SimRobot, name: str) -> float:
 class PlaceRecord:
     """What a place did, recorded as it ran (`record_place`): at each opening of the hand,
     the object's lowest point (m, `world` z) and the upward force on it from below (N); the
-    checkers each stow and each carry to the place went around."""
+    checkers each way to stand by and each carry to the place went around."""
 
     let_go_at: list[float] = dataclasses.field(default_factory=list)
     pressed: list[float] = dataclasses.field(default_factory=list)
-    stows: list[CollisionChecker | None] = dataclasses.field(default_factory=list)
+    rests: list[CollisionChecker | None] = dataclasses.field(default_factory=list)
     carries: list[CollisionChecker] = dataclasses.field(default_factory=list)
 
 
@@ -73,7 +73,7 @@ def record_place(
     """Record what a place of object `name` by `b` does (`PlaceRecord`), and a function
     that stops recording the gripper."""
     record = PlaceRecord()
-    gripper, stow, go_to = robot.gripper, b.stow, b.go_to
+    gripper, stand_by, go_to = robot.gripper, b.stand_by, b.go_to
 
     def recording_gripper(close: bool) -> None:
         if not close:
@@ -82,9 +82,9 @@ def record_place(
             record.pressed.append(borne_from_below(robot, name))
         gripper(close)
 
-    def recording_stow(checker: CollisionChecker | None = None) -> Outcome:
-        record.stows.append(checker)
-        return stow(checker)
+    def recording_stand_by(checker: CollisionChecker | None = None) -> Outcome:
+        record.rests.append(checker)
+        return stand_by(checker)
 
     def recording_go_to(
         q_goal: np.ndarray, checker: CollisionChecker, what: str, *args: object, **kw: object
@@ -94,7 +94,7 @@ def record_place(
         return go_to(q_goal, checker, what, *args, **kw)
 
     robot.gripper = recording_gripper  # type: ignore[method-assign]
-    b.stow = recording_stow  # type: ignore[method-assign]
+    b.stand_by = recording_stand_by  # type: ignore[method-assign]
     b.go_to = recording_go_to  # type: ignore[method-assign]
 
     def stop() -> None:
@@ -153,14 +153,14 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     stop_recording()
     assert out.ok, out.failure
     assert out.timings[CARRY_PLANNING] > 0  # the place poses and the path there
-    # The carry there and the stow after went around a wall under the table's front
+    # The carry there and the way to stand by after went around a wall under the table's front
     # (`surface_front`), at the nearest of its top the cameras saw, down to the floor,
     # where they saw little of the table: what the hand holds may hang below it.
     seen = cloud.points[obstacle_mask(cloud.points)]
     edge = seen[np.abs(seen[:, 2] - TABLE_TOP) < 0.01][:, 0].min()
     walled = under_the_edge(seen, edge) + 500
-    assert record.stows and record.stows[0] is not None
-    assert under_the_edge(record.stows[0].points, edge) > walled
+    assert record.rests and record.rests[0] is not None
+    assert under_the_edge(record.rests[0].points, edge) > walled
     assert len(record.carries) == 1, "the walled carry found its way"
     assert under_the_edge(record.carries[0].points, edge) > walled
     let_go_at, pressed = record.let_go_at, record.pressed
@@ -178,8 +178,9 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
     robot.sleep(1.0)
     error = np.linalg.norm(referee.position(name)[:2] - (out.spot[:2] + offset))
     assert error < 0.03, f"{error * 100:.1f} cm from where it should stand"
-    # The arm folded away around it: stowed, and the object where it was set down.
-    assert np.max(np.abs(robot.joint_state().q - dims.UR5_HOME_Q)) < 0.05
+    # The arm went around it to stand by for the next pick, and the object stands where it
+    # was set down.
+    assert np.max(np.abs(robot.joint_state().q - dims.UR5_STANDBY_Q)) < 0.05
     up = matrix_from_quat(referee.world_quat(name)) @ up0
     assert up[2] > np.cos(np.radians(15)), "it should stand as it stood"
     # The place's post-condition, from what the cameras see with the arm gone: it stands
@@ -192,9 +193,9 @@ def test_picked_object_is_placed_upright_at_the_mark(robot):
 
 
 def test_what_the_cameras_see_now_has_the_objects_and_not_the_arm(robot):
-    """After a place the arm stows around what the cameras see then: the object where it
-    really stands (it may have slid in the pads), not the arm's own points, which would
-    leave the planner no clear start."""
+    """After a place the arm goes to stand by around what the cameras see then: the object
+    where it really stands (it may have slid in the pads), not the arm's own points, which
+    would leave the planner no clear start."""
     b = Behaviours(robot)
     assert b.go_ready().ok
     q = robot.joint_state().q

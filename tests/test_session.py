@@ -235,8 +235,8 @@ def test_a_second_click_on_the_dot_confirms_though_a_new_capture_sees_otherwise(
 
 
 def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there() -> None:
-    """The place's post-condition (EL-E 000 section 6), from the capture the stow after it
-    takes: an object standing where the hand let it go is "Placed."; where the cameras see
+    """The place's post-condition (EL-E 000 section 6), from the capture the stand-by after
+    it takes: an object standing where the hand let it go is "Placed."; where the cameras see
     the surface bare instead (the opened hand took it along, say), the user hears so."""
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
@@ -244,17 +244,17 @@ def test_after_a_place_the_session_says_when_the_object_no_longer_stands_there()
         standing = truth.object_points("mug_1")  # as a place would have let it go
         spot = np.array([*standing[:, :2].mean(axis=0), standing[:, 2].min()])
         placed = Outcome(spot=spot, standing=standing)
-        session.stow_and_rest("Placed.", placed=placed)
+        session.stand_by_and_rest("Placed.", placed=placed)
         assert session.state == TaskState.IDLE
         assert session.failure is None and session.message == "Placed. Ready."
         truth.take_out("mug_1")
-        session.stow_and_rest("Placed.", placed=placed)
+        session.stand_by_and_rest("Placed.", placed=placed)
         assert session.state == TaskState.IDLE
         assert session.failure is not None and session.failure.message == PLACED_NOT_STANDING
         # Where the arm then fails to get home too, that is said first, and the fall with it.
         stuck = Outcome(Failure("ik_plan", "No way home was found."))
-        session.behaviours.stow = lambda checker=None: stuck  # type: ignore[method-assign]
-        session.stow_and_rest("Placed.", placed=placed)
+        session.behaviours.stand_by = lambda checker=None: stuck  # type: ignore[method-assign]
+        session.stand_by_and_rest("Placed.", placed=placed)
         assert session.failure is not None and session.failure.kind == "ik_plan"
         assert session.failure.message == f"No way home was found. {PLACED_NOT_STANDING}"
     finally:
@@ -416,11 +416,11 @@ def test_a_drop_let_go_partly_past_the_basket_opening_asks_the_user_to_check() -
         session.close()
 
 
-def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() -> None:
+def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_stands_by() -> None:
     """Picked in pick-and-place, the mug is to be tucked in. Here what the cameras saw is
     told to fill every pose it could be held at, tucked in or raised in front, so no way
-    there is found: the hand sets the mug back down where it stood and the arm stows, the
-    user told why, free to mark it again."""
+    there is found: the hand sets the mug back down where it stood and the empty arm stands
+    by for the next try, the user told why, free to mark it again."""
     session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
     try:
         robot, actor, b = session.robot, Actor("bench"), session.behaviours
@@ -452,7 +452,7 @@ def test_an_object_that_cannot_be_tucked_in_is_put_back_and_the_arm_goes_home() 
         assert b.held is None and not robot.gripper_state().closed
         now = truth.world_position("mug_1")
         assert np.linalg.norm(now[:2] - stood[:2]) < 0.01 and abs(now[2] - stood[2]) < 0.005
-        assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05, "stowed"
+        assert np.abs(robot.joint_state().q - dims.UR5_STANDBY_Q).max() < 0.05, "standing by"
     finally:
         session.close()
 

@@ -1,5 +1,6 @@
 """The basket drop: carry what the hand holds over the basket, let it go, and take the arm
-back to ready (or stowed), around the object where it was let go."""
+to stand by for the next pick (or to ready, or stowed), around the object where it was let
+go."""
 
 from __future__ import annotations
 
@@ -36,10 +37,11 @@ class BasketDrop(Carrying, Leaving, Stowing):
     """The drop in the basket (`drop_in_basket`)."""
 
     def drop_in_basket(self) -> Outcome:
-        """Carry what the hand holds to the basket, release it, and return to ready (stowed
-        where neither ready pose is clear). Let go partly past the basket's opening, the
-        outcome says so (`PAST_THE_OPENING`): as its caution, or in its failure. Its timings
-        give the carry's planning (`CARRY_PLANNING`, wall-clock s)."""
+        """Carry what the hand holds to the basket, release it, and stand by for the next
+        pick (to ready, or stowed, where no way there is found: `_leave_basket`). Let go
+        partly past the basket's opening, the outcome says so (`PAST_THE_OPENING`): as its
+        caution, or in its failure. Its timings give the carry's planning
+        (`CARRY_PLANNING`, wall-clock s)."""
         if self.held is None or not self.robot.gripper_state().holding:
             self.held = None
             return Outcome(Failure("precondition", NOT_HOLDING))
@@ -110,10 +112,12 @@ class BasketDrop(Carrying, Leaving, Stowing):
         """From over the basket, the open hand rises off the object (`let_go`, m, `base`)
         before it turns away: a tall bottle stands up out of the basket, and a straight way
         to ready sweeps the fingers through it. Where its pads still press the object, they
-        are freed first (`free_the_pads`): risen, the hand would lift it out. Then to ready
-        around the object as it was let go, else as it fell, lower (no way around it); where
-        a shelf's or a high table's boards fill both ready poses, folded away from the
-        basket instead, as the session's stow would do next."""
+        are freed first (`free_the_pads`): risen, the hand would lift it out. Then straight
+        to stand by for the next pick (`go_stand_by`), as the session does next, around the
+        object as it was let go, else as it fell, lower (no way around it); where no way
+        there is found, to ready, else folded away. Through ready, the arm stood by only
+        where a ready pose was clear; where a shelf's or a high table's boards filled both,
+        it folded away, and the next pick turned its elbow over on the way out."""
         around = CollisionChecker(
             np.vstack([held.surroundings.points, let_go]),
             margin=self.settings.motion.clearance,
@@ -123,7 +127,7 @@ class BasketDrop(Carrying, Leaving, Stowing):
         failure = self.rise_clear(around, hand_on_the_way=held.surroundings)
         if failure is not None:
             return Outcome(failure)
-        for leave in (self.go_ready, self.fold_away):
+        for leave in (self.go_stand_by, self.go_ready, self.fold_away):
             for checker in (around, held.surroundings):
                 back = leave(checker)
                 if back.failure is None or back.failure.kind != "ik_plan":

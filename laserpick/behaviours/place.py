@@ -1,5 +1,5 @@
 """The place (004 section 7.3, EL-E 000 section 4.5): carry what the hand holds over a
-place mark, lower it until the surface is felt, let go, leave it, and stow around it."""
+place mark, lower it until the surface is felt, let go, leave it, and stand by around it."""
 
 from __future__ import annotations
 
@@ -40,11 +40,12 @@ class Placing(Carrying, Leaving, Stowing):
         kept, so that it stands as it stood, its grasp height above the surface: straight
         down from 10 cm above until the surface is felt (`place_contact_force`), eased
         `place_ease` back up, then the hand opens and leaves it (drawn back along its
-        approach where that way is clear, else straight up), and the arm stows around the
-        object where it now stands. Felt more than `place_above` early, it is something on
-        the surface: the hand keeps the object and rises. Nothing felt by `place_below`
-        under the rest: the hand keeps it. The outcome's timings give the carry's planning
-        (`CARRY_PLANNING`: the place poses and the path, wall-clock s).
+        approach where that way is clear, else straight up), and the arm stands by for the
+        next pick around the object where it now stands (stowed where no way there is
+        found). Felt more than `place_above` early, it is something on the surface: the hand
+        keeps the object and rises. Nothing felt by `place_below` under the rest: the hand
+        keeps it. The outcome's timings give the carry's planning (`CARRY_PLANNING`: the
+        place poses and the path, wall-clock s).
         """
         s = self.settings.motion
         if self.held is None or not self.robot.gripper_state().holding:
@@ -77,7 +78,7 @@ class Placing(Carrying, Leaving, Stowing):
         failure = self.leave_object(poses.T_above, checker)
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot).planned_for(planning)
-        placed = self._stow_around_placed(held, T_release, checker, spot)
+        placed = self._stand_by_around_placed(held, T_release, checker, spot)
         return placed.planned_for(planning)
 
     def _carry_over_spot(
@@ -132,14 +133,14 @@ class Placing(Carrying, Leaving, Stowing):
         self.release()
         return None
 
-    def _stow_around_placed(
+    def _stand_by_around_placed(
         self, held: Held, T_release: np.ndarray, checker: CollisionChecker, spot: np.ndarray
     ) -> Outcome:
-        """Stow around the object `held` where it now stands (let go with the TCP at
-        T_release, `base`), as held and as the cameras now see it: an object that slid or
-        turned in the pads stands off where it was held, and unchecked, a stow sweeps the
-        hand through it. `checker`: what the place went around; `spot`: where it was set
-        down (m, `base`)."""
+        """Stand by (`stand_by`: stowed where no way there is found) around the object
+        `held` where it now stands (let go with the TCP at T_release, `base`), as held and as
+        the cameras now see it: an object that slid or turned in the pads stands off where
+        it was held, and unchecked, the way sweeps the hand through it. `checker`: what the
+        place went around; `spot`: where it was set down (m, `base`)."""
         s = self.settings.motion
         standing = held.standing_at(T_release)
         seen = np.vstack([checker.points, self.seen_without_arm()])
@@ -153,14 +154,14 @@ class Placing(Carrying, Leaving, Stowing):
         # First around a wall under the surface's seen front (`surface_front`: a counter's
         # front runs out of the cameras' view before its top does), then without it.
         front = front_wall(seen, float(spot[2]))
-        back = self.stow(around.with_points(front))
+        back = self.stand_by(around.with_points(front))
         if back.failure is not None and back.failure.kind == "ik_plan" and len(front):
-            back = self.stow(around)
+            back = self.stand_by(around)
         if back.failure is not None and back.failure.kind == "ik_plan":
             # The object as held can stand for more than it is (a plush toy's mirrored
             # back), and the hand drawn back out of it still stands inside it: around what
             # the cameras see alone, a way home is found.
-            back = self.stow(without)
+            back = self.stand_by(without)
         if back.failure is not None:
             msg = back.failure.message
             failure = Failure(back.failure.kind, f"Set down; then {msg[:1].lower()}{msg[1:]}")

@@ -17,7 +17,8 @@ __all__ = ["Stowing"]
 
 
 class Stowing(GuardedMotion):
-    """Going to ready (`go_ready`), stowing (`stow`) and standing by (`stand_by`)."""
+    """Going to ready (`go_ready`), stowing (`stow`) and standing by (`stand_by`,
+    `go_stand_by`)."""
 
     def go_ready(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the ready pose, raised in front with the gripper down, or to the high ready
@@ -67,11 +68,17 @@ class Stowing(GuardedMotion):
         found neither ready pose clear) the way to standing by turns the elbow over."""
         if at_rest(self.current_q()):
             return Outcome()
-        around = checker or CollisionChecker(np.zeros((0, 3)))
-        out = self.go_to(dims.UR5_STANDBY_Q, around, "standing by", via=(dims.UR5_HIGH_READY_Q,))
+        out = self.go_stand_by(checker)
         if out.failure is not None and out.failure.kind == "ik_plan":
             return self.stow(checker)
         return out
+
+    def go_stand_by(self, checker: CollisionChecker | None = None) -> Outcome:
+        """To the pose the arm stands by in (`dims.UR5_STANDBY_Q`), directly or through the
+        high ready pose, around what `checker` holds (None: an empty cloud; the scooter
+        is always checked)."""
+        around = checker or CollisionChecker(np.zeros((0, 3)))
+        return self.go_to(dims.UR5_STANDBY_Q, around, "standing by", via=(dims.UR5_HIGH_READY_Q,))
 
     def fold_away(self, checker: CollisionChecker | None = None) -> Outcome:
         """To the unstow pose, then straight home: the way out of the stowed pose, backwards,

@@ -157,7 +157,7 @@ class Jobs(Retreat, Foresight):
             self._retreat(out.failure)
             return
         said = "Dropped in the basket." + (f" {out.caution}" if out.caution else "")
-        self.stow_and_rest(said, standby=True)
+        self.stand_by_and_rest(said)
 
     def _place_job(self) -> None:
         with self._lock:
@@ -181,7 +181,7 @@ class Jobs(Retreat, Foresight):
             assert out.failure is not None
             self._retreat(out.failure)
             return
-        self.stow_and_rest("Placed.", placed=out)
+        self.stand_by_and_rest("Placed.", placed=out)
 
     def _count_carry_planning(self, out: Outcome) -> None:
         """Add what `out` spent planning the way of what the hand holds (`CARRY_PLANNING`,

@@ -1,5 +1,5 @@
-"""How a job ends on the arm: stow and rest after a drop or a place (checking first that a
-placed object still stands), and the retreat after a failure, a cancel or the e-stop, which
+"""How a job ends on the arm: stand by and rest after a drop or a place (checking first that
+a placed object still stands), and the retreat after a failure, a cancel or the e-stop, which
 keeps an object in the hand, tucks it in, or puts it back where it was picked up.
 
 Frames: points in `base` (m).
@@ -40,7 +40,7 @@ _STAYS = (ESTOP_REASON, SILENT_REASON, STALLED_REASON)
 
 
 class Retreat(KeptViews):
-    """The end of a job on the arm: stow, or retreat, and rest."""
+    """The end of a job on the arm: stand by, or retreat, and rest."""
 
     def _retake_held_surroundings(self) -> None:
         """Where the scooter has moved since the pick with the object in hand, take anew what
@@ -63,19 +63,17 @@ class Retreat(KeptViews):
             around = around.without(~not_carried(around.points, held.at(tcp_pose(q))))
         self.behaviours.held = replace(held, surroundings=around, seen_from=now)
 
-    def stow_and_rest(
-        self, message: str, placed: Outcome | None = None, standby: bool = False
-    ) -> None:
-        """Stow and rest, saying `message`; after a place (`placed`), first check from the
-        same capture that the object still stands where it was let go. standby: rest standing
-        by for the next pick instead (`Behaviours.stand_by`), as after a drop in the basket.
-        A job's last step: it moves the arm, so call it only while no job runs."""
+    def stand_by_and_rest(self, message: str, placed: Outcome | None = None) -> None:
+        """Stand by for the next pick (`Behaviours.stand_by`: stowed where no way there is
+        found) and rest, saying `message`; after a place (`placed`), first check from the
+        same capture that the object still stands where it was let go. A job's last step: it
+        moves the arm, so call it only while no job runs."""
         capture = self.capture_or_none()
         gone = (
             placed is not None and capture is not None and self._placed_object_gone(capture, placed)
         )
         around = self.surroundings(capture)
-        out = self.behaviours.stand_by(around) if standby else self.behaviours.stow(around)
+        out = self.behaviours.stand_by(around)
         with self._lock:
             self._forget_task()
             if out.failure is not None:  # the arm not home is said first; a fall with it
@@ -100,8 +98,9 @@ class Retreat(KeptViews):
         """After a failed or cancelled step: retreat to a safe pose and rest. An object in the
         hand is kept (never dropped from height): the arm tucks it in and the session holds;
         where no way to tuck it in is found, it is put back where it was picked up, if the
-        arm can go back down the way it came (`Behaviours.put_back`), and the arm stows
-        (an arm still at rest, stowed or standing by, stays there).
+        arm can go back down the way it came (`Behaviours.put_back`). The empty arm then
+        stands by for the next try (`Behaviours.stand_by`: stowed where no way there is
+        found; an arm still at rest, stowed or standing by, stays there).
         After the e-stop or the dead-man the arm stays where it stopped.
         tucked: how the tuck that failed just now went (not tried again)."""
         if DEADMAN_STOP in failure.message:
@@ -136,7 +135,7 @@ class Retreat(KeptViews):
             b.held = None
             if not at_rest(self.robot.joint_state().q):  # a pick that found no way: stays
                 self._progress("Returning the arm.")
-                b.stow(self.surroundings(self.capture_or_none()))
+                b.stand_by(self.surroundings(self.capture_or_none()))
         with self._lock:
             if cancelled:
                 self._cancel.set()  # so the journal records the job as cancelled

@@ -2,7 +2,7 @@
 
     idle ─aim→ aiming ─confirm→ marked → perceived → grasps_ready ─execute→ executing
       ↑                                                                      │
-      └──────────── (dropped in the basket, or placed, then stowed) ←── holding
+      └─────── (dropped in the basket, or placed, then standing by) ←── holding
                                                      awaiting_place ─confirm→ placing
 
 - idle: nothing under way; the laser may be off.
@@ -15,7 +15,7 @@
 - holding: the object is in the hand (carried to the basket in pick-and-drop; after a
   cancel, waiting for `execute` to drop it or for a place mark).
 - awaiting_place: pick-and-place holds the object high and waits for the place mark.
-- placing: the arm sets the object down at the mark, then stows.
+- placing: the arm sets the object down at the mark, then stands by for the next pick.
 """
 
 from __future__ import annotations
