@@ -71,7 +71,7 @@ def basket_way(
     """The carry of `held` to the basket from q_from (6,) rad, searched with `rng`; None
     where the arm and what it holds are not clear there (the carry first rises clear,
     `Carrying.rise_clear`, and searches from where that leaves it)."""
-    if not held.surroundings.clearance_ok(q_from, payload=held.points_tcp)[0]:
+    if not held.clear_at(q_from):
         return None
     drops = drop_postures_for(q_from, held, settings)
     return BasketWay(drops, path_to_a_drop(q_from, drops, held, settings, rng))

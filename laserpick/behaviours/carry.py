@@ -191,7 +191,7 @@ def tuck_way(
     searches it: what the motion does (`TUCKING` or `RAISING`) and its joint path (K, 6)
     rad. None where the arm and what it holds are not clear at q_from (the tuck rises clear
     first) or no search found a way. Reads nothing of the robot: run while the arm lifts."""
-    if not held.surroundings.clearance_ok(q_from, payload=held.points_tcp)[0]:
+    if not held.clear_at(q_from):
         return None
     carry, high = _holding_poses(held, settings)
     kw = {"payload": held.points_tcp}

@@ -32,6 +32,11 @@ class Held:
     seen_from: np.ndarray | None = None
     seen_tcp: np.ndarray | None = None
 
+    def clear_at(self, q: np.ndarray) -> bool:
+        """Whether the arm at joint angles q (6,) rad, and what it holds, keep clear of the
+        `surroundings`: where a carry's search may start."""
+        return bool(self.surroundings.clearance_ok(q, payload=self.points_tcp)[0])
+
     def at(self, T_tcp: np.ndarray) -> np.ndarray:
         """The object's points (m, `base`) with the TCP at pose T_tcp (4, 4), `base`."""
         return self.points_tcp @ T_tcp[:3, :3].T + T_tcp[:3, 3]
