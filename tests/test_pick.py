@@ -48,6 +48,16 @@ def grasp_set_at(pose: np.ndarray, checker: CollisionChecker) -> GraspSet:
     return GraspSet(group([g]), (), checker, checker, target, "vertical")
 
 
+def withdraw(b: Behaviours, approach: np.ndarray, checker: CollisionChecker, payload=None) -> None:
+    """Draw the hand back level the way `withdrawal_path` finds, as the pick does after a
+    lift from the side (at the lift's speed holding `payload`); stay where it finds none."""
+    path = b.withdrawal_path(approach, checker, payload)
+    if path is not None:
+        s = b.settings.motion
+        speed = s.lift_speed if payload is not None else s.approach_speed
+        assert b.run_withdrawal(path, speed) is None
+
+
 def point_ahead(q_side: np.ndarray) -> CollisionChecker:
     """A point 5-10 mm ahead of the fingers of the hand at `side_pose(1.70, -0.30, 0.80)`
     (joint angles q_side): inside the 1 cm margin, short of touching."""
@@ -157,16 +167,16 @@ def test_a_grasp_from_the_side_is_drawn_back_out_level_after_the_lift(robot):
     q_side = next(q for q in ik_tcp(side, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
     assert b.go_to(q_side, free, "test").ok
     payload = np.zeros((1, 3))
-    assert b.withdraw(side[:3, 2], free, payload) is None
+    withdraw(b, side[:3, 2], free, payload)
     np.testing.assert_allclose(
         tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
     )
     assert b.go_to(q_side, free, "test").ok
     post = post_behind(q_side, payload)
     stood = robot.joint_state().q
-    assert b.withdraw(side[:3, 2], post, payload) is None
+    withdraw(b, side[:3, 2], post, payload)
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
-    assert b.withdraw(top_down(1.6, -0.3, 0.8)[:3, 2], free, payload) is None
+    withdraw(b, top_down(1.6, -0.3, 0.8)[:3, 2], free, payload)
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
 
 
@@ -189,7 +199,7 @@ def test_a_side_grasp_blocked_straight_back_draws_back_level_a_little_turned(rob
             post = near
             break
     assert post is not None, "no post beside the way back blocks it"
-    assert b.withdraw(side[:3, 2], post) is None
+    withdraw(b, side[:3, 2], post)
     moved = tcp_pose(robot.joint_state().q)[:3, 3] - side[:3, 3]
     assert abs(moved[2]) < 0.005 and np.linalg.norm(moved) > 0.045, "backed out level"
     turn = np.degrees(np.arccos(-moved[0] / np.linalg.norm(moved)))
@@ -204,7 +214,7 @@ def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_
     side = side_pose(1.70, -0.30, 0.80)
     q_side, _ = hand_at(b, side)
     ahead = point_ahead(q_side)
-    assert b.withdraw(side[:3, 2], ahead) is None
+    withdraw(b, side[:3, 2], ahead)
     np.testing.assert_allclose(
         tcp_pose(robot.joint_state().q)[:3, 3], [1.60, -0.30, 0.80], atol=0.005
     )
@@ -212,7 +222,7 @@ def test_a_hand_that_starts_within_the_margin_still_draws_back_if_the_way_keeps_
     hand_at(b, side)
     both = CollisionChecker(np.vstack([ahead.points, post_behind(q_side).points]))
     stood = robot.joint_state().q
-    assert b.withdraw(side[:3, 2], both) is None
+    withdraw(b, side[:3, 2], both)
     np.testing.assert_allclose(robot.joint_state().q, stood, atol=2e-3)
 
 
@@ -240,5 +250,5 @@ def test_a_hand_that_starts_within_the_margin_leaves_the_arm_its_own(robot):
             break
     assert post is not None, "no point comes within the margin of the arm drawn back"
     both = CollisionChecker(np.vstack([ahead.points, post.points]))
-    assert b.withdraw(side[:3, 2], both) is None
+    withdraw(b, side[:3, 2], both)
     assert post.clearance_ok(robot.joint_state().q, hand=False)[0]

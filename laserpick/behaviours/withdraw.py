@@ -19,23 +19,8 @@ __all__ = ["Withdrawing"]
 
 
 class Withdrawing(GuardedMotion):
-    """The hand drawn back along its approach (`withdraw`, `withdrawal_path`)."""
-
-    def withdraw(
-        self,
-        approach: np.ndarray,
-        checker: CollisionChecker,
-        payload: np.ndarray | None = None,
-        *,
-        level: bool = True,
-    ) -> Failure | None:
-        """Draw the hand back the way `withdrawal_path` finds; stay where it finds none.
-        Holding `payload`, at the lift's speed (`lift_speed`), else at the approach's."""
-        path = self.withdrawal_path(approach, checker, payload, level=level)
-        if path is None:
-            return None
-        s = self.settings.motion
-        return self.run_withdrawal(path, s.lift_speed if payload is not None else s.approach_speed)
+    """The hand drawn back along its approach: the way found (`withdrawal_path`), then run
+    (`run_withdrawal`)."""
 
     def run_withdrawal(self, path: np.ndarray, speed: float | None = None) -> Failure | None:
         """Run a way back (N, 6) that `withdrawal_path` found, at TCP `speed` (m/s; default:
