@@ -48,7 +48,12 @@ def grasp_set_at(pose: np.ndarray, checker: CollisionChecker) -> GraspSet:
     return GraspSet(group([g]), (), checker, checker, target, "vertical")
 
 
-def withdraw(b: Behaviours, approach: np.ndarray, checker: CollisionChecker, payload=None) -> None:
+def withdraw(
+    b: Behaviours,
+    approach: np.ndarray,
+    checker: CollisionChecker,
+    payload: np.ndarray | None = None,
+) -> None:
     """Draw the hand back level the way `withdrawal_path` finds, as the pick does after a
     lift from the side (at the lift's speed holding `payload`); stay where it finds none."""
     path = b.withdrawal_path(approach, checker, payload)
