@@ -4,6 +4,7 @@ who backs up as asked within the try."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +61,17 @@ def test_the_least_step_back_that_lets_the_arm_take_a_grasp_too_near_it() -> Non
     nearer = [level_grasp(x - BACK_UP_STEPS[1] + 0.005)]
     assert not takes(nearer[0])
     assert back_up_advice(nearer, NOTHING, UR5_READY_Q, MOTION) == BACK_UP_STEPS[1]
+
+
+def test_a_grasp_a_few_centimetres_too_near_asks_for_a_few_centimetres() -> None:
+    """The robot asks for the least step back, to 5 cm: each step takes the object farther
+    from the arm, and a cereal box on the bookshelf that 10 cm took out of reach was taken
+    from 5 cm back."""
+    x = nearest_taken()
+    too_near = [level_grasp(x - 0.045)]
+    assert not takes(too_near[0])
+    assert back_up_advice(too_near, NOTHING, UR5_READY_Q, MOTION) == 0.05
+    assert all(b - a <= 0.05 + 1e-9 for a, b in itertools.pairwise(BACK_UP_STEPS))
 
 
 def test_no_advice_where_backing_up_does_not_help() -> None:

@@ -3,11 +3,11 @@
 At a bookshelf parked close, the forearm comes down onto the board above the object for
 every posture of every grasp; from farther back it comes in level. When the reachability
 filter leaves no grasp, the same grasps are tried as they would lie after backing up
-straight by each of BACK_UP_STEPS: the grasps and the seen cloud move forward by that much
-in `base` (the scooter and its rider, which the checker models in `base`, stay). The first
-step from which some grasp has a collision-free posture is what the robot asks for. Only
-postures are checked, against what the cameras saw from here; the view from there decides
-the grasps after the drive.
+straight by each of BACK_UP_STEPS (5 to 20 cm): the grasps and the seen cloud move forward
+by that much in `base` (the scooter and its rider, which the checker models in `base`,
+stay). The first step from which some grasp has a collision-free posture is what the robot
+asks for. Only postures are checked, against what the cameras saw from here; the view from
+there decides the grasps after the drive.
 
 Frames: `base` (x forward, the scooter's heading), metres.
 """
@@ -27,8 +27,10 @@ from laserpick.types import Grasp
 __all__ = ["ADVICE_GRASPS", "BACK_UP_STEPS", "back_up_advice", "backed_up_grasps"]
 
 #: How far back (m) the robot considers asking the user to park, nearest first: a person
-#: backs a scooter up by a hand's breadth or two, not across the room.
-BACK_UP_STEPS = (0.10, 0.20)
+#: backs a scooter up by a hand's breadth or two, not across the room. The least that serves
+#: is asked for, to 5 cm: each step back takes the object farther from the arm, and a
+#: cereal box on the bookshelf's middle board that 10 cm took out of reach was taken from 5.
+BACK_UP_STEPS = (0.05, 0.10, 0.15, 0.20)
 #: At most this many of the grasps (evenly sampled) are tried from each step, which filters
 #: them again: a step that suits any grasp suits many.
 ADVICE_GRASPS = 60
