@@ -3,11 +3,11 @@
 At a bookshelf parked close, the forearm comes down onto the board above the object for
 every posture of every grasp; from farther back it comes in level. When the reachability
 filter leaves no grasp, the same grasps are tried as they would lie after backing up
-straight by each of BACK_UP_STEPS (5 to 20 cm): the grasps and the seen cloud move forward
-by that much in `base` (the scooter and its rider, which the checker models in `base`,
-stay). The first step from which some grasp has a collision-free posture is what the robot
-asks for. Only postures are checked, against what the cameras saw from here; the view from
-there decides the grasps after the drive.
+straight by each of BACK_UP_STEPS: the grasps and the seen cloud move forward by that much
+in `base` (the scooter and its rider, which the checker models in `base`, stay). The first
+step from which some grasp has a collision-free posture is what the robot asks for. Only
+postures are checked, against what the cameras saw from here; the view from there decides
+the grasps after the drive.
 
 Frames: `base` (x forward, the scooter's heading), metres.
 """
