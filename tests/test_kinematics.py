@@ -125,3 +125,14 @@ def test_joint_limits_and_speeds_come_from_dims(arm):
     np.testing.assert_allclose(m.jnt_range[:, 1], dims.UR5_Q_MAX)
     assert dims.UR5_Q_MAX[2] == pytest.approx(math.pi)
     assert pytest.approx(3.14) == dims.UR5_QD_MAX
+
+
+def test_nearest_turns_turns_only_the_wrists_and_keeps_the_posture():
+    """The wrists take the 2*pi-equivalent nearest the reference; shoulder and elbow keep
+    theirs, and angles that need no turn come back exactly."""
+    q = np.array([2.9, -0.6, -1.75, -0.52, 4.56, 1.52])
+    ref = dims.UR5_UNSTOW_Q
+    out = K.nearest_turns(q, ref)
+    np.testing.assert_array_equal(out[[0, 1, 2, 3, 5]], q[[0, 1, 2, 3, 5]])
+    assert out[4] == pytest.approx(4.56 - 2 * math.pi)
+    np.testing.assert_allclose(K.tcp_pose(out), K.tcp_pose(q), atol=1e-9)

@@ -356,6 +356,35 @@ def test_from_standing_by_the_transit_keeps_the_elbow_up_and_is_seconds_shorter(
     assert standby.transit.duration < home.transit.duration - 2.5
 
 
+def test_a_grasp_on_the_other_elbow_branch_is_reached_without_a_wrist_turning_over():
+    """A high side grasp whose IK, taken nearest the ready pose, is elbow down with the
+    middle wrist at +4.6 rad: from standing by, the way out turns the elbow over at the unstow
+    pose (that wrist at -1.57 rad), and the leg on to the grasp does not turn it back over
+    by a full turn: the grasp is the same posture, the wrist at -1.65 rad."""
+    s = get_settings().motion
+    world = CollisionChecker(EMPTY)
+    T = tcp_pose(np.array([-0.16, -0.6, -1.75, -0.52, -1.73, 1.52]))
+    T[:3, 3] += 0.10 * T[:3, 2]
+    q_grasp = next(q for q in ik_tcp(T, dims.UR5_READY_Q) if q[2] < 0 and q[4] > np.pi)
+    plan = plan_pick(
+        dims.UR5_STANDBY_Q,
+        q_grasp,
+        world,
+        world,
+        np.random.default_rng(0),
+        s,
+        via=(dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q),
+        standby=True,
+        unstow=dims.UR5_STANDBY_EXIT_Q,
+        turn=dims.UR5_UNSTOW_Q,
+    )
+    assert not isinstance(plan, Failure), plan
+    np.testing.assert_allclose(tcp_pose(plan.q_grasp), T, atol=1e-6)
+    assert plan.q_grasp[4] < 0
+    # Standing by, the wrist is at +1.57 rad: down to the unstow pose's -1.57 and no farther.
+    assert np.ptp(plan.transit.q[:, 4]) < np.pi + 0.2
+
+
 def test_the_lift_keeps_what_the_hand_will_hold_off_the_forearm():
     """Far out over the 87 cm counter, the arm straightens as it lifts and its forearm comes
     down over the hand. A bowl 14 cm across held by its far rim would end the full lift

@@ -55,6 +55,18 @@ def wrap(q: np.ndarray) -> np.ndarray:
     return (q + np.pi) % (2 * np.pi) - np.pi
 
 
+def nearest_turns(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    """Joint angles q (6,) rad with each wrist joint (the last three) taken as its
+    2*pi-equivalent nearest q_ref (6,) rad, where that lies within the joint limits: the same
+    posture, reached from q_ref without a wrist turning more than half a turn. The shoulder
+    and elbow keep their angles, which keep the arm on the side of the scooter it works on."""
+    out = np.array(q, dtype=float)
+    near = out + 2 * math.pi * np.round((np.asarray(q_ref, dtype=float) - out) / (2 * math.pi))
+    within = (near >= dims.UR5_Q_MIN - 1e-9) & (near <= dims.UR5_Q_MAX + 1e-9)
+    out[3:] = np.where(within, near, out)[3:]  # exactly q where no turn is needed
+    return out
+
+
 def ik_flange(T_ur5_flange: np.ndarray) -> np.ndarray:
     """All analytic solutions (k, 6) for a flange pose in `ur5`, angles wrapped to [-pi, pi).
 
