@@ -33,11 +33,15 @@ from laserpick.behaviours import (
     holds_over_basket,
     rank_drop_postures,
 )
+from laserpick.behaviours.basket_way import path_to_a_drop
+from laserpick.behaviours.carry import holding_poses
 from laserpick.behaviours.drop_postures import clear_carrying, reach_times
+from laserpick.behaviours.held import Held
 from laserpick.behaviours.laid_in import hand_down_turns
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
+from laserpick.pipeline import joint_search
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.motion_limits import motion_limits
@@ -45,6 +49,7 @@ from laserpick.pipeline.perceive import perceive
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotz
+from laserpick.types import Grasp
 
 
 @pytest.fixture
@@ -412,3 +417,30 @@ def test_the_drop_judge_fails_every_miss(offset: tuple[float, float], said: str)
     else:
         pytest.fail("a mug outside the basket passed")
     assert_in_basket(_mug_record((-0.4, 0.3), in_basket=True))
+
+
+def test_where_no_way_leads_straight_out_the_carry_goes_through_the_tucked_pose(monkeypatch):
+    """Out of a shelf's gap, no search from where the lift left the object reaches a drop
+    posture or the high ready pose: the carry is searched through the tucked pose, the way
+    the tuck takes, and runs on to the basket in one path."""
+    q_from = np.array([-1.1, -1.6, 1.1, 2.2, 1.0, 1.3])
+    held = Held(
+        grasp=Grasp(tcp_pose(q_from), 0.05),
+        height_above_support=0.05,
+        points_tcp=box_points((0.05, 0.05, 0.1)),
+        middle_tcp=np.zeros(3),
+        surroundings=CollisionChecker(np.zeros((0, 3))),
+    )
+    tucked, _ = holding_poses(held, SETTINGS)
+
+    def only_through_the_tuck(a, b, *args, **kw):
+        from_tuck, to_tuck = np.allclose(a, tucked), np.allclose(np.atleast_2d(b)[0], tucked)
+        return np.array([a, np.atleast_2d(b)[0]]) if from_tuck or to_tuck else None
+
+    monkeypatch.setattr(joint_search, "joint_path", only_through_the_tuck)
+    drops = [np.array(q) for q in drop_candidates()[:3]]
+    path = path_to_a_drop(q_from, drops, held, SETTINGS, np.random.default_rng(0))
+    assert path is not None
+    np.testing.assert_allclose(path[0], q_from)
+    assert any(np.allclose(q, tucked) for q in path)
+    assert any(np.allclose(path[-1], d) for d in drops)

@@ -8,10 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from laserpick.behaviours.carry import holding_pose
+from laserpick.behaviours.carry import holding_poses
 from laserpick.behaviours.drop_postures import drop_configurations
 from laserpick.behaviours.held import Held
-from laserpick.description import dims
 from laserpick.pipeline.joint_search import joint_path_via
 from laserpick.settings import Settings
 
@@ -50,17 +49,17 @@ def path_to_a_drop(
 ) -> np.ndarray | None:
     """The joint path (K, 6) rad from q_from to one of the best `drop_tries` of `drops`: the
     straight move to the first that has one, else the first a search with `rng` toward all
-    of them at once reaches (`joint_path`), through the high ready pose where the direct
-    search finds none; None where none does."""
-    b = settings.behaviour
-    high = holding_pose(dims.UR5_HIGH_READY_Q, held.surroundings, held.points_tcp, b.hold_turns)
+    of them at once reaches (`joint_path`); where the direct search finds none, through the
+    high ready pose, else through the tucked pose, the way out of a shelf's gap that the
+    tuck takes, on to the basket without a stop there; None where none does."""
+    tucked, high = holding_poses(held, settings)
     return joint_path_via(
         q_from,
-        np.array(drops[: b.drop_tries]),
+        np.array(drops[: settings.behaviour.drop_tries]),
         held.surroundings,
         rng,
         settings.motion,
-        via=(high,),
+        via=(high, tucked),
         payload=held.points_tcp,
     )
 

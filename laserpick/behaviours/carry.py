@@ -21,7 +21,15 @@ from laserpick.pipeline.motion_limits import timed
 from laserpick.settings import Settings
 from laserpick.types import Failure
 
-__all__ = ["RAISING", "TUCKING", "Carrying", "holding_pose", "tuck_way", "without_leftovers"]
+__all__ = [
+    "RAISING",
+    "TUCKING",
+    "Carrying",
+    "holding_pose",
+    "holding_poses",
+    "tuck_way",
+    "without_leftovers",
+]
 
 #: What the tuck's motions do, as the user hears it: to the tucked pose, or raised in front.
 TUCKING = "tucking it in"
@@ -174,7 +182,7 @@ class Carrying(GuardedMotion):
         return Outcome(failure).planned_for(planning)
 
 
-def _holding_poses(held: Held, settings: Settings) -> tuple[np.ndarray, np.ndarray]:
+def holding_poses(held: Held, settings: Settings) -> tuple[np.ndarray, np.ndarray]:
     """The tucked pose and the high ready pose (6,) rad, each with the wrist turned where
     `held` keeps clear there (`holding_pose`)."""
     turns = settings.behaviour.hold_turns
@@ -193,7 +201,7 @@ def tuck_way(
     first) or no search found a way. Reads nothing of the robot: run while the arm lifts."""
     if not held.clear_at(q_from):
         return None
-    carry, high = _holding_poses(held, settings)
+    carry, high = holding_poses(held, settings)
     kw = {"payload": held.points_tcp}
     for _ in range(settings.behaviour.tuck_searches):
         path = joint_path_via(
