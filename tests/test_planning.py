@@ -31,7 +31,7 @@ from laserpick.pipeline.rrt import shortcut
 from laserpick.pipeline.selection import group
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.transforms import rotation_angle, rotx
-from laserpick.types import Failure, Grasp
+from laserpick.types import DepthFrame, Failure, Grasp
 
 
 def test_filter_keeps_reachable_grasps_and_says_why_it_drops_others():
@@ -515,6 +515,24 @@ def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch
     searches.forget_failed()
     assert searches.path(home, ready, checker, rng, s) is None
     assert calls == [(0.0, 0.5), (0.5, 1.0), (0.0, 0.5)] and searches.failed == 3
+
+
+def test_a_leg_searched_again_is_one_leg_to_explain(monkeypatch) -> None:
+    """A leg held to seen space that found no way is kept once to say why (`blocked`), even
+    when the second pass searches it again and it fails again."""
+    monkeypatch.setattr(joint_search, "joint_path", lambda *args, **kw: None)
+    frame = DepthFrame(
+        depth=np.ones((4, 4)), ir=np.zeros((0, 0), np.uint8), K=np.eye(3),
+        T_base_cam=np.eye(4), camera="c", stamp=0.0,
+    )  # fmt: skip
+    checker = CollisionChecker(EMPTY, frames=[frame])
+    searches = joint_search.Searches(max_failed=6)
+    a, b, s = np.zeros(6), np.full(6, 0.5), get_settings().motion
+    rng = np.random.default_rng(0)
+    assert searches.path(a, b, checker, rng, s) is None
+    searches.forget_failed()
+    assert searches.path(a, b, checker, rng, s) is None
+    assert searches.failed == 2 and len(searches.blocked) == 1
 
 
 def _one_grasp_pick(x: float, y: float, z: float) -> GraspSet:

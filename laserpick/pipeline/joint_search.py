@@ -147,9 +147,16 @@ class Searches:
             self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:
                 self.failed += 1
-                if seen and checker.frames:
+                # Searched again after `forget_failed`, a leg is still one leg to explain.
+                if seen and checker.frames and not self._blocked_before(key):
                     self.blocked.append((a, b, checker))
         return self.legs[key]
+
+    def _blocked_before(self, key: tuple[bytes, bytes]) -> bool:
+        return any(
+            (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes()) == key
+            for a, b, _ in self.blocked
+        )
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
