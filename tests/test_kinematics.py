@@ -128,11 +128,23 @@ def test_joint_limits_and_speeds_come_from_dims(arm):
 
 
 def test_nearest_turns_turns_only_the_wrists_and_keeps_the_posture():
-    """The wrists take the 2*pi-equivalent nearest the reference; shoulder and elbow keep
-    theirs, and angles that need no turn come back exactly."""
+    """The last two wrists take the 2*pi-equivalent nearest the reference; shoulder and
+    elbow keep theirs, and angles that need no turn come back exactly."""
     q = np.array([2.9, -0.6, -1.75, -0.52, 4.56, 1.52])
     ref = dims.UR5_UNSTOW_Q
     out = K.nearest_turns(q, ref)
     np.testing.assert_array_equal(out[[0, 1, 2, 3, 5]], q[[0, 1, 2, 3, 5]])
     assert out[4] == pytest.approx(4.56 - 2 * math.pi)
     np.testing.assert_allclose(K.tcp_pose(out), K.tcp_pose(q), atol=1e-9)
+
+
+def test_nearest_turns_keeps_the_hands_pitch_not_the_first_wrist_nearest():
+    """Shoulder, elbow and first wrist turn about parallel axes, and their sum pitches the
+    hand: the first wrist takes the angle that keeps that sum nearest the reference's, even
+    where another is nearer its own angle. From the floor to a drop posture the nearer first
+    wrist turned the hand over on the way."""
+    ref = np.array([-0.31, -0.41, 1.86, 0.12, 1.57, 1.26])  # sum of 1-3: 1.57
+    q = np.array([-1.11, -1.49, -1.26, 4.32, 1.57, -1.11])  # sum of 1-3: 1.57
+    out = K.nearest_turns(q, ref)
+    assert out[3] == q[3], "its own nearest, -1.96, would pitch the hand a turn"
+    assert out[1:4].sum() == pytest.approx(ref[1:4].sum(), abs=1e-2)
