@@ -131,7 +131,7 @@ def transit_path(
 ) -> tuple[np.ndarray, list[ClearFn]] | None:
     """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`,
     each leg searched once per pick (`searches`): through the way out of where the arm
-    rests (`_way_out`), or else through the first of `via` that the world shows clear. The
+    rests (`_way_to`), or else through the first of `via` that the world shows clear. The
     leg to the pre-grasp keeps the hand to space the cameras saw through; so do the legs
     before it, but for the fixed way out of a rest pose. None when a leg finds no way; else
     the waypoints and, for each segment between them, the check its leg was searched with
@@ -166,46 +166,33 @@ def _way_to(
     turn: np.ndarray | None,
 ) -> tuple[list[np.ndarray], bool]:
     """The configurations (rad) the transit to the pre-grasp q_pre passes before its last
-    leg, q_now first, and whether they are the fixed way out of a rest pose (`_way_out`;
-    else the first of `via` the world shows clear). Only q_pre's elbow branch counts."""
-    clear = [q for q in via if world.clearance_ok(q)[0]]
-    out = _way_out(q_now, q_pre, world, clear, unstow, standby, turn)
-    return [q_now, *(clear[:1] if out is None else out)], out is not None
-
-
-def _way_out(
-    q_now: np.ndarray,
-    q_pre: np.ndarray,
-    world: CollisionChecker,
-    clear: Sequence[np.ndarray],
-    unstow: np.ndarray | None,
-    standby: bool,
-    turn: np.ndarray | None,
-) -> list[np.ndarray] | None:
-    """The waypoints (rad) of the fixed way out of a rest pose to a pre-grasp q_pre: legs
-    of straight moves beside the scooter, where no camera sees, not held to seen space.
-    None when q_now is not a rest pose, or its way out is not clear in the `world`.
+    leg, q_now first, and whether they are the fixed way out of a rest pose: legs of
+    straight moves beside the scooter, where no camera sees, not held to seen space. Not
+    from a rest pose, or where its way out is not clear in the `world`: q_now and the first
+    of `via` that the world shows clear. Only q_pre's elbow branch counts.
 
     From the stowed pose (`unstow` given, `UR5_UNSTOW_Q`): through the unstow pose, then the
-    first `clear` ready pose, where the elbow turns over; where none is clear (a shelf's
-    boards fill both), for a pre-grasp on the other elbow branch, on to `turn` (standing
-    by's exit, `UR5_STANDBY_EXIT_Q`), the elbow up. From standing by (`standby`), the
-    elbow up: to the first clear ready pose, else through `unstow`, its exit
+    first clear pose of `via`, where the elbow turns over; where none is clear (a shelf's
+    boards fill both ready poses), for a pre-grasp on the other elbow branch, on to `turn`
+    (standing by's exit, `UR5_STANDBY_EXIT_Q`), the elbow up. From standing by (`standby`),
+    the elbow up: to the first clear ready pose, else through `unstow`, its exit
     (`UR5_STANDBY_EXIT_Q`); for a pre-grasp on the other elbow branch, on to `turn` (the
     unstow pose) as the stow goes. Either way the elbow turns over on the way out, not on
     the leg held to seen space: turned there, the hand swings through space no camera saw,
     and each grasp's search spent all its samples (a pill bottle on the bookshelf, 16 s)."""
+    clear = [q for q in via if world.clearance_ok(q)[0]]
     if not standby:
         if unstow is None or not world.clearance_ok(unstow)[0]:
-            return None
+            return [q_now, *clear[:1]], False
         if not clear and turn is not None and q_pre[2] * unstow[2] < 0:
-            return [unstow, turn] if world.clearance_ok(turn)[0] else [unstow]
-        return [unstow, *clear[:1]]
+            return [q_now, unstow, *([turn] if world.clearance_ok(turn)[0] else [])], True
+        return [q_now, unstow, *clear[:1]], True
     if turn is not None and q_pre[2] * q_now[2] < 0 and world.clearance_ok(turn)[0]:
-        return [*clear[:1], turn]
+        return [q_now, *clear[:1], turn], True
     if clear:
-        return [clear[0]]
-    return [unstow] if unstow is not None and world.clearance_ok(unstow)[0] else []
+        return [q_now, clear[0]], True
+    exit_clear = unstow is not None and world.clearance_ok(unstow)[0]
+    return [q_now, *([unstow] if exit_clear else [])], True
 
 
 def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool) -> ClearFn:
@@ -238,7 +225,7 @@ def plan_pick(
     fixed too, beside the scooter; `unstow` is then its exit, taken only where no ready
     pose is clear (`transit_path`). turn: where the way out ends for a grasp on the other
     elbow branch: from standing by, `UR5_UNSTOW_Q`; from the stowed pose where no ready
-    pose is clear, `UR5_STANDBY_EXIT_Q` (`_way_out`).
+    pose is clear, `UR5_STANDBY_EXIT_Q` (`_way_to`).
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
