@@ -8,7 +8,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from arm_poses import top_grasp
 from arm_setups import BEHAVIOUR, SETTINGS, TABLE_TOP, isolation_robot, pick_object, side_pose
 
 from laserpick.behaviours import (
@@ -354,24 +353,3 @@ def test_a_crowded_place_says_on_which_side_and_which_way_to_move_the_mark():
         (move,) = [k for k in MARK_MOVES if message.rstrip(".").endswith(k)]
         assert MARK_MOVES[move] == way
     assert crowded_message(np.zeros((0, 3)), spot).endswith("there.")
-
-
-def test_the_carry_to_the_place_turns_the_hand_the_short_way_from_where_it_starts():
-    """Tucked in with the hand turned a half turn (`hold_turns`), the last wrist stands near
-    4.35 rad; the place's posture, taken nearest the high ready pose, stands 4.5 rad from it.
-    Taken from where the carry starts, no wrist is more than half a turn away, and the
-    posture is the same."""
-    T = top_grasp(1.6, -0.3, 0.80, yaw=1.5)
-    free = CollisionChecker(np.zeros((0, 3)))
-    grasp = Grasp(pose=T, width=0.06, ik=ik_tcp(T, dims.UR5_READY_Q)[0])
-    held = Held(grasp, 0.05, np.zeros((1, 3)), np.zeros(3), free)
-    spot = np.array([1.55, -0.30, 0.75])
-    tucked = dims.UR5_CARRY_Q + np.array([0, 0, 0, 0, 0, np.pi])
-    ready_nearest = place_poses(held, spot, free, SETTINGS)
-    from_tuck = place_poses(held, spot, free, SETTINGS, q_from=tucked)
-    assert not isinstance(ready_nearest, Failure) and not isinstance(from_tuck, Failure)
-    assert np.abs(ready_nearest.q_above[3:] - tucked[3:]).max() > np.pi
-    assert np.abs(from_tuck.q_above[3:] - tucked[3:]).max() <= np.pi
-    np.testing.assert_allclose(
-        tcp_pose(from_tuck.q_above), tcp_pose(ready_nearest.q_above), atol=1e-9
-    )

@@ -59,7 +59,7 @@ class Placing(Carrying, Leaving, Stowing):
         t0 = time.perf_counter()
         obstacles = cloud.points[not_carried(cloud.points, held.at(tcp_pose(q_now)))]
         checker = CollisionChecker(obstacles, margin=s.clearance, q_self=q_now)
-        poses = place_poses(held, spot, checker, self.settings, q_from=q_now)
+        poses = place_poses(held, spot, checker, self.settings)
         planning = time.perf_counter() - t0
         if isinstance(poses, Failure):
             return Outcome(poses).planned_for(planning)

@@ -12,7 +12,7 @@ import numpy as np
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.messages import crowded_message
 from laserpick.description import dims
-from laserpick.description.kinematics import ik_tcp, nearest_turns
+from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline.collision import CollisionChecker, obstacle_mask, surface_front
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.surface import SURFACE_BAND, on_floor
@@ -61,11 +61,7 @@ class _Obstruction:
 
 
 def place_poses(
-    held: Held,
-    spot: np.ndarray,
-    checker: CollisionChecker,
-    settings: Settings,
-    q_from: np.ndarray | None = None,
+    held: Held, spot: np.ndarray, checker: CollisionChecker, settings: Settings
 ) -> PlacePoses | Failure:
     """Where to set the object `held` down at `spot` (m, `base`), or why it cannot be.
 
@@ -78,11 +74,7 @@ def place_poses(
     The surface itself (its points within `surface.SURFACE_BAND` of its height) it must
     only not reach into, and may come nearer than the margin: a jar held from the side a
     few centimetres above its support goes down with the wrist's spheres millimetres over
-    the surface, as they were at the pick. So with the floor, for a spot on it.
-
-    q_from (6,) rad: where the carry there starts; each posture's wrists are then turned the
-    short way from it (`nearest_turns`): tucked in with the hand turned a half turn, the
-    carry to the angles nearest the ready pose could spin the hand up to a turn more."""
+    the surface, as they were at the pick. So with the floor, for a spot on it."""
     s = settings.motion
     reached = False
     obstruction = _Obstruction()
@@ -100,10 +92,11 @@ def place_poses(
         T_above = T_place.copy()
         T_above[2, 3] = rest + s.approach_distance
         # Nearest the poses in front first, whether the object is tucked in or raised.
-        solutions = ik_tcp(T_above, dims.UR5_HIGH_READY_Q)
-        if q_from is not None:
-            solutions = [nearest_turns(q, q_from) for q in solutions]
-        clear = [q for q in solutions if checker.clearance_ok(q, payload=held.points_tcp)[0]]
+        clear = [
+            q
+            for q in ik_tcp(T_above, dims.UR5_HIGH_READY_Q)
+            if checker.clearance_ok(q, payload=held.points_tcp)[0]
+        ]
         reached = reached or bool(clear)
         T_rest = T_place.copy()
         T_rest[2, 3] = rest
