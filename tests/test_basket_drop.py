@@ -444,19 +444,3 @@ def test_where_no_way_leads_straight_out_the_carry_goes_through_the_tucked_pose(
     np.testing.assert_allclose(path[0], q_from)
     assert any(np.allclose(q, tucked) for q in path)
     assert any(np.allclose(path[-1], d) for d in drops)
-
-
-def test_from_a_grasp_on_the_other_elbow_branch_the_drop_turns_the_wrists_the_short_way():
-    """Lifted off the 108 cm table elbow down, the arm's wrists stand far from the ready
-    pose's, whose nearest angles the grid of drop postures takes: ranked from there, each
-    posture turns no wrist more than half a turn, and the best is reached in about 5 s where
-    the grid's own angles took 7.6 s."""
-    q_from = np.array([-0.24, -0.42, -1.77, -0.69, -1.65, 1.5])
-    payload = box_points((0.06, 0.06, 0.20))
-    drops = drop_configurations(
-        q_from, CollisionChecker(np.zeros((0, 3))), payload, settings=BEHAVIOUR
-    )
-    assert drops
-    assert max(np.abs(q[3:] - q_from[3:]).max() for q in drops) <= np.pi + 1e-9
-    limits = motion_limits(SETTINGS.motion, carrying=True)
-    assert reach_times(q_from, np.array(drops[:1]), limits)[0] < 6.0

@@ -11,7 +11,7 @@ import numpy as np
 
 from laserpick.behaviours.laid_in import hand_turns, laid_in_candidates, scooter_only
 from laserpick.description import dims
-from laserpick.description.kinematics import ik_tcp, nearest_turns, tcp_pose
+from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, held_at
 from laserpick.pipeline.motion_limits import motion_limits
 from laserpick.pipeline.timing import Limits, straight_times
@@ -204,8 +204,7 @@ def rank_drop_postures(
     settings: BehaviourSettings,
     motion: MotionSettings | None = None,
 ) -> list[tuple[DropRank, np.ndarray]]:
-    """The clear `candidates` (clear with `payload`, TCP frame, m), their wrists turned the
-    short way from q_ref (`nearest_turns`), that hold the middle of
+    """The clear `candidates` (clear with `payload`, TCP frame, m) that hold the middle of
     the object as it falls (`falls`, TCP frame, m) over the opening, and none of it past the
     opening's back edge, toward the rider, each with its rank key, sorted. Wholly inside the
     opening: (0, 0, 0, fall, time); partly past it: (1, coarse fall, steps past, fall,
@@ -216,10 +215,7 @@ def rank_drop_postures(
     if not candidates:
         return []
     floor = dims.BASKET_FLOOR
-    # Each posture with its wrists turned the short way from q_ref: the grid's angles are
-    # the ready pose's nearest, and from a grasp on the other elbow branch the carry to
-    # them turned a wrist 5 rad (a bottle from the 108 cm table: 7.6 s, against 5.1 s).
-    Q = np.array([nearest_turns(q, q_ref) for q in candidates])
+    Q = np.array(candidates)
     T = tcp_pose(Q)
     pts = falls if len(falls) else np.zeros((1, 3))
     held = held_at(T, pts)  # (B, P, 3)
