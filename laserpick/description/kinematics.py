@@ -61,10 +61,10 @@ def nearest_turns(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     joint limits. The last two wrists each take the angle nearest q_ref's. The first
     wrist's axis is parallel to the shoulder's and the elbow's, and the three angles' sum
     pitches the hand: it takes the angle that brings that sum nearest q_ref's, or a
-    "shorter" first wrist turns the hand over (a carry to the basket from the floor, 7.8 s
-    of straight move against 12.6 s). Shoulder and elbow keep their angles, which keep the
-    arm on the side of the scooter it works on; angles that need no turn come back
-    exactly."""
+    "shorter" first wrist turns the hand over (from a grasp on the floor to a posture over
+    the basket, a straight move of 12.6 s against 7.8 s). Shoulder and elbow keep their
+    angles, which keep the arm on the side of the scooter it works on; angles that need no
+    turn come back exactly."""
     out = np.array(q, dtype=float)
     ref = np.asarray(q_ref, dtype=float)
     gap = ref - out
