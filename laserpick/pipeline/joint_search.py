@@ -127,7 +127,9 @@ class Searches:
     max_failed: int
     failed: int = 0
     legs: dict[tuple[bytes, bytes], np.ndarray | None] = field(default_factory=dict)
-    blocked: list[tuple[np.ndarray, np.ndarray, CollisionChecker]] = field(default_factory=list)
+    blocked: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray, CollisionChecker]] = field(
+        default_factory=dict
+    )
 
     def path(
         self,
@@ -147,16 +149,10 @@ class Searches:
             self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:
                 self.failed += 1
-                # Searched again after `forget_failed`, a leg is still one leg to explain.
-                if seen and checker.frames and not self._blocked_before(key):
-                    self.blocked.append((a, b, checker))
+                # Keyed as `legs`: searched again after `forget_failed`, still one leg.
+                if seen and checker.frames:
+                    self.blocked.setdefault(key, (a, b, checker))
         return self.legs[key]
-
-    def _blocked_before(self, key: tuple[bytes, bytes]) -> bool:
-        return any(
-            (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes()) == key
-            for a, b, _ in self.blocked
-        )
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
@@ -169,7 +165,7 @@ class Searches:
         quick = s.model_copy(update={"rrt_max_samples": UNSEEN_SAMPLES})
         return any(
             joint_path(a, b, checker, rng, quick, hand=True) is not None
-            for a, b, checker in self.blocked[:BLIND_LEGS]
+            for a, b, checker in list(self.blocked.values())[:BLIND_LEGS]
         )
 
     def forget_failed(self) -> None:
