@@ -40,7 +40,7 @@ from laserpick.behaviours.held import Held
 from laserpick.behaviours.laid_in import hand_down_turns
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
-from laserpick.description.kinematics import tcp_pose
+from laserpick.description.kinematics import nearest_turns, tcp_pose
 from laserpick.pipeline import joint_search
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
@@ -419,10 +419,10 @@ def test_the_drop_judge_fails_every_miss(offset: tuple[float, float], said: str)
     assert_in_basket(_mug_record((-0.4, 0.3), in_basket=True))
 
 
-def test_where_no_way_leads_straight_out_the_carry_goes_through_the_tucked_pose(monkeypatch):
-    """Out of a shelf's gap, no search from where the lift left the object reaches a drop
-    posture or the high ready pose: the carry is searched through the tucked pose, the way
-    the tuck takes, and runs on to the basket in one path."""
+def _held_in_a_gap(monkeypatch) -> tuple[np.ndarray, Held, np.ndarray]:
+    """Where the lift left an object in a shelf's gap (rad), what the hand holds, and the
+    tucked pose (rad): the searches are stood in for by ways that exist only to and from
+    the tucked pose (straight moves)."""
     q_from = np.array([-1.1, -1.6, 1.1, 2.2, 1.0, 1.3])
     held = Held(
         grasp=Grasp(tcp_pose(q_from), 0.05),
@@ -438,9 +438,33 @@ def test_where_no_way_leads_straight_out_the_carry_goes_through_the_tucked_pose(
         return np.array([a, np.atleast_2d(b)[0]]) if from_tuck or to_tuck else None
 
     monkeypatch.setattr(joint_search, "joint_path", only_through_the_tuck)
+    return q_from, held, tucked
+
+
+def test_where_no_way_leads_straight_out_the_carry_goes_through_the_tucked_pose(monkeypatch):
+    """Out of a shelf's gap, no search from where the lift left the object reaches a drop
+    posture or the high ready pose: the carry is searched through the tucked pose, the way
+    the tuck takes, and runs on to the basket in one path."""
+    q_from, held, tucked = _held_in_a_gap(monkeypatch)
     drops = [np.array(q) for q in drop_candidates()[:3]]
     path = path_to_a_drop(q_from, drops, held, SETTINGS, np.random.default_rng(0))
     assert path is not None
     np.testing.assert_allclose(path[0], q_from)
     assert any(np.allclose(q, tucked) for q in path)
     assert any(np.allclose(path[-1], d) for d in drops)
+
+
+def test_on_from_the_tucked_pose_the_drops_wrists_turn_the_short_way(monkeypatch):
+    """The drops are chosen for where the lift left the object, and may hold a wrist a whole
+    turn from the tucked pose's: the leg on from the tuck ends at the same hand pose over
+    the basket, each wrist within half a turn of the tuck's (the first wrist's by the sum
+    that pitches the hand, `nearest_turns`)."""
+    q_from, held, tucked = _held_in_a_gap(monkeypatch)
+    drop = np.array(drop_candidates()[0])
+    drop[4] += -2 * np.pi if drop[4] > 0 else 2 * np.pi  # the same hand, a turn away
+    assert abs(drop[4] - tucked[4]) > np.pi
+    path = path_to_a_drop(q_from, [drop], held, SETTINGS, np.random.default_rng(0))
+    assert path is not None and any(np.allclose(q, tucked) for q in path)
+    np.testing.assert_allclose(tcp_pose(path[-1]), tcp_pose(drop), atol=1e-9)
+    assert np.all(np.abs(path[-1][4:] - tucked[4:]) <= np.pi)
+    np.testing.assert_allclose(path[-1], nearest_turns(drop, tucked))

@@ -51,7 +51,8 @@ def path_to_a_drop(
     straight move to the first that has one, else the first a search with `rng` toward all
     of them at once reaches (`joint_path`); where the direct search finds none, through the
     high ready pose, else through the tucked pose, the way out of a shelf's gap that the
-    tuck takes, on to the basket without a stop there; None where none does."""
+    tuck takes, on to the basket without a stop there, the drops' wrists turned the short
+    way from each (`joint_path_via`); None where none does."""
     tucked, high = holding_poses(held, settings)
     return joint_path_via(
         q_from,
@@ -60,6 +61,7 @@ def path_to_a_drop(
         rng,
         settings.motion,
         via=(high, tucked),
+        turn_goals=True,
         payload=held.points_tcp,
     )
 
