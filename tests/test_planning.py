@@ -13,25 +13,22 @@ from pydantic import ValidationError
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import body_frames
-from laserpick.pipeline import joint_search, rrt
+from laserpick.pipeline import rrt
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
     held_clear_of_arm,
     sphere_centres,
 )
-from laserpick.pipeline.first_plan import plan_first
-from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches, joint_path
 from laserpick.pipeline.lines import TURN_STEP, cartesian_line
 from laserpick.pipeline.plan import plan_pick, straight_lift, transit_path
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut
-from laserpick.pipeline.selection import group
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.transforms import rotation_angle, rotx
-from laserpick.types import DepthFrame, Failure, Grasp
+from laserpick.types import Failure, Grasp
 
 
 def test_filter_keeps_reachable_grasps_and_says_why_it_drops_others():
@@ -489,95 +486,6 @@ def test_what_stands_between_the_open_fingers_is_closed_on_and_what_stands_besid
             assert not isinstance(plan, Failure), plan
         else:
             assert isinstance(plan, Failure) and "hit something beside" in plan.message
-
-
-def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch) -> None:
-    """The leg from the stowed arm to ready is the same for every grasp of a pick: a failed
-    search of it is not repeated per grasp, and failed searches stop the pick at the cap."""
-    calls: list[tuple[float, float]] = []
-
-    def no_path(a, b, *args, **kw):
-        calls.append((float(a[0]), float(b[0])))
-        return None
-
-    monkeypatch.setattr(joint_search, "joint_path", no_path)
-    searches = joint_search.Searches(max_failed=2)
-    home, ready, pre = np.zeros(6), np.full(6, 0.5), np.full(6, 1.0)
-    s = get_settings().motion
-    rng = np.random.default_rng(0)
-    checker = CollisionChecker(np.zeros((0, 3)))
-    for _ in range(3):
-        assert searches.path(home, ready, checker, rng, s) is None
-    assert calls == [(0.0, 0.5)] and not searches.spent
-    assert searches.path(ready, pre, checker, rng, s) is None
-    assert searches.spent and searches.failed == 2
-    # Forgotten, a failed leg is searched anew, and counted again.
-    searches.forget_failed()
-    assert searches.path(home, ready, checker, rng, s) is None
-    assert calls == [(0.0, 0.5), (0.5, 1.0), (0.0, 0.5)] and searches.failed == 3
-
-
-def test_a_leg_searched_again_is_one_leg_to_explain(monkeypatch) -> None:
-    """A leg held to seen space that found no way is kept once to say why (`blocked`), even
-    when the second pass searches it again and it fails again."""
-    monkeypatch.setattr(joint_search, "joint_path", lambda *args, **kw: None)
-    frame = DepthFrame(
-        depth=np.ones((4, 4)), ir=np.zeros((0, 0), np.uint8), K=np.eye(3),
-        T_base_cam=np.eye(4), camera="c", stamp=0.0,
-    )  # fmt: skip
-    checker = CollisionChecker(EMPTY, frames=[frame])
-    searches = joint_search.Searches(max_failed=6)
-    a, b, s = np.zeros(6), np.full(6, 0.5), get_settings().motion
-    rng = np.random.default_rng(0)
-    assert searches.path(a, b, checker, rng, s) is None
-    searches.forget_failed()
-    assert searches.path(a, b, checker, rng, s) is None
-    assert searches.failed == 2 and len(searches.blocked) == 1
-
-
-def _one_grasp_pick(x: float, y: float, z: float) -> GraspSet:
-    """A pick of one top grasp at (x, y, z) m in `base` over an empty world."""
-    world = CollisionChecker(EMPTY)
-    T = top_grasp(x, y, z)
-    grasp = Grasp(pose=T, width=0.05, ik=ik_tcp(T, dims.UR5_READY_Q)[0])
-    return GraspSet(group([grasp]), (), world, world, T[:3, 3][None], "gpd")
-
-
-@pytest.mark.parametrize("max_failed", [1, 2])
-def test_a_grasp_whose_way_was_not_found_is_planned_again_through_the_high_ready_pose(
-    monkeypatch, max_failed
-) -> None:
-    """From standing by, the one grasp's leg from ready to its pre-grasp finds no way: within
-    the budget the grasp is planned once more, its way out through the high ready pose and
-    the failed leg searched anew; with the budget spent after the first, the pick says no."""
-    legs: list[tuple[bytes, bytes]] = []
-    failed_once: set[bytes] = set()
-
-    def first_search_fails(a, b, *args, **kw):
-        legs.append((np.round(a, 6).tobytes(), np.round(b, 6).tobytes()))
-        fixed = any(np.allclose(b, q) for q in (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q))
-        if not fixed and b.tobytes() not in failed_once:
-            failed_once.add(b.tobytes())
-            return None
-        return np.array([a, b], float)
-
-    monkeypatch.setattr(joint_search, "joint_path", first_search_fails)
-    s = get_settings().motion.model_copy(update={"rrt_max_failed": max_failed})
-    found = _one_grasp_pick(1.55, -0.25, 0.50)
-    plan, grasp, tried = plan_first(found, dims.UR5_STANDBY_Q, np.random.default_rng(0), settings=s)
-    assert tried == 1
-    if max_failed == 1:
-        assert isinstance(plan, Failure) and grasp is None
-        assert plan.message.startswith("No collision-free path in 1 searches")
-        assert len(legs) == 2  # the fixed way to ready, the pre-grasp leg once
-        return
-    assert not isinstance(plan, Failure), plan
-    assert np.allclose(plan.transit.q[0], dims.UR5_STANDBY_Q)
-    # Out to ready and on to the pre-grasp, no way; out to the high ready pose and on.
-    key = [np.round(q, 6).tobytes() for q in (dims.UR5_STANDBY_Q, dims.UR5_READY_Q)]
-    high = np.round(dims.UR5_HIGH_READY_Q, 6).tobytes()
-    pre = legs[1][1]
-    assert legs == [tuple(key), (key[1], pre), (key[0], high), (high, pre)]
 
 
 def test_lifts_out_of_order_are_refused_saying_which():

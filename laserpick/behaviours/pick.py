@@ -97,15 +97,19 @@ class Picking(Withdrawing):
 
     def _basket_admits(self, grasps: GraspSet) -> Callable[[Grasp], Failure | None]:
         """For `plan_first`: refuses a grasp that holds the object, as carried and as it
-        falls, where no drop posture holds it over the basket."""
+        falls, where no drop posture holds it over the basket. Each grasp is judged once:
+        `plan_first` may ask of it again in a later pass."""
         carried, falls = grasps.carried, grasps.carried_as_seen  # one array where none was cut off
         margin, b = self.settings.motion.clearance, self.settings.behaviour
+        judged: dict[int, Failure | None] = {}
 
         def admits(grasp: Grasp) -> Failure | None:
-            fall = None if falls is carried else grasp.in_hand(falls)
-            if holds_over_basket(grasp.in_hand(carried), fall, margin=margin, settings=b):
-                return None
-            return Failure("ik_plan", NO_BASKET_HOLD)
+            if id(grasp) not in judged:
+                fall = None if falls is carried else grasp.in_hand(falls)
+                held = grasp.in_hand(carried)
+                ok = holds_over_basket(held, fall, margin=margin, settings=b)
+                judged[id(grasp)] = None if ok else Failure("ik_plan", NO_BASKET_HOLD)
+            return judged[id(grasp)]
 
         return admits
 

@@ -1,0 +1,155 @@
+"""Planning a pick's grasps in order (`first_plan`): the searches a pick shares, the short
+searches first, and the second pass through the high ready pose. The searches are stood
+in for (monkeypatched) where a test needs one to find or miss a way."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from arm_poses import EMPTY, top_grasp
+
+from laserpick.description import dims
+from laserpick.description.kinematics import ik_tcp
+from laserpick.pipeline import first_plan, joint_search
+from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.first_plan import plan_first
+from laserpick.pipeline.grasp_choice import GraspSet
+from laserpick.pipeline.reach import pregrasp_pose
+from laserpick.pipeline.selection import group
+from laserpick.settings import get_settings
+from laserpick.types import DepthFrame, Failure, Grasp
+
+
+def test_a_pick_searches_each_leg_once_and_gives_up_after_its_budget(monkeypatch) -> None:
+    """The leg from the stowed arm to ready is the same for every grasp of a pick: a failed
+    search of it is not repeated per grasp, and failed searches stop the pick at the cap."""
+    calls: list[tuple[float, float]] = []
+
+    def no_path(a, b, *args, **kw):
+        calls.append((float(a[0]), float(b[0])))
+        return None
+
+    monkeypatch.setattr(joint_search, "joint_path", no_path)
+    searches = joint_search.Searches(max_failed=2)
+    home, ready, pre = np.zeros(6), np.full(6, 0.5), np.full(6, 1.0)
+    s = get_settings().motion
+    rng = np.random.default_rng(0)
+    checker = CollisionChecker(np.zeros((0, 3)))
+    for _ in range(3):
+        assert searches.path(home, ready, checker, rng, s) is None
+    assert calls == [(0.0, 0.5)] and not searches.spent
+    assert searches.path(ready, pre, checker, rng, s) is None
+    assert searches.spent and searches.failed == 2
+    # Forgotten, a failed leg is searched anew, and counted again.
+    searches.forget_failed()
+    assert searches.path(home, ready, checker, rng, s) is None
+    assert calls == [(0.0, 0.5), (0.5, 1.0), (0.0, 0.5)] and searches.failed == 3
+
+
+def test_a_leg_searched_again_is_one_leg_to_explain(monkeypatch) -> None:
+    """A leg held to seen space that found no way is kept once to say why (`blocked`), even
+    when the second pass searches it again and it fails again."""
+    monkeypatch.setattr(joint_search, "joint_path", lambda *args, **kw: None)
+    frame = DepthFrame(
+        depth=np.ones((4, 4)), ir=np.zeros((0, 0), np.uint8), K=np.eye(3),
+        T_base_cam=np.eye(4), camera="c", stamp=0.0,
+    )  # fmt: skip
+    checker = CollisionChecker(EMPTY, frames=[frame])
+    searches = joint_search.Searches(max_failed=6)
+    a, b, s = np.zeros(6), np.full(6, 0.5), get_settings().motion
+    rng = np.random.default_rng(0)
+    assert searches.path(a, b, checker, rng, s) is None
+    searches.forget_failed()
+    assert searches.path(a, b, checker, rng, s) is None
+    assert searches.failed == 2 and len(searches.blocked) == 1
+
+
+def _one_grasp_pick(x: float, y: float, z: float) -> GraspSet:
+    """A pick of one top grasp at (x, y, z) m in `base` over an empty world."""
+    world = CollisionChecker(EMPTY)
+    T = top_grasp(x, y, z)
+    grasp = Grasp(pose=T, width=0.05, ik=ik_tcp(T, dims.UR5_READY_Q)[0])
+    return GraspSet(group([grasp]), (), world, world, T[:3, 3][None], "gpd")
+
+
+@pytest.mark.parametrize("max_failed", [1, 2])
+def test_a_grasp_whose_way_was_not_found_is_planned_again_through_the_high_ready_pose(
+    monkeypatch, max_failed
+) -> None:
+    """From standing by, the one grasp's leg from ready to its pre-grasp finds no way: within
+    the budget the grasp is planned once more, its way out through the high ready pose and
+    the failed leg searched anew; with the budget spent after the first, the pick says no."""
+    legs: list[tuple[bytes, bytes]] = []
+    failed_once: set[bytes] = set()
+
+    def first_search_fails(a, b, checker, rng, s, **kw):
+        if s.rrt_max_samples <= first_plan.QUICK_SAMPLES:
+            return None  # the short searches find no way either
+        legs.append((np.round(a, 6).tobytes(), np.round(b, 6).tobytes()))
+        fixed = any(np.allclose(b, q) for q in (dims.UR5_READY_Q, dims.UR5_HIGH_READY_Q))
+        if not fixed and b.tobytes() not in failed_once:
+            failed_once.add(b.tobytes())
+            return None
+        return np.array([a, b], float)
+
+    monkeypatch.setattr(joint_search, "joint_path", first_search_fails)
+    s = get_settings().motion.model_copy(update={"rrt_max_failed": max_failed})
+    found = _one_grasp_pick(1.55, -0.25, 0.50)
+    plan, grasp, tried = plan_first(found, dims.UR5_STANDBY_Q, np.random.default_rng(0), settings=s)
+    assert tried == 1
+    if max_failed == 1:
+        assert isinstance(plan, Failure) and grasp is None
+        assert plan.message.startswith("No collision-free path in 1 searches")
+        assert len(legs) == 2  # the fixed way to ready, the pre-grasp leg once
+        return
+    assert not isinstance(plan, Failure), plan
+    assert np.allclose(plan.transit.q[0], dims.UR5_STANDBY_Q)
+    # Out to ready and on to the pre-grasp, no way; out to the high ready pose and on.
+    key = [np.round(q, 6).tobytes() for q in (dims.UR5_STANDBY_Q, dims.UR5_READY_Q)]
+    high = np.round(dims.UR5_HIGH_READY_Q, 6).tobytes()
+    pre = legs[1][1]
+    assert legs == [tuple(key), (key[1], pre), (key[0], high), (high, pre)]
+
+
+def _grasps_pick(*where: tuple[float, float, float]) -> GraspSet:
+    """A pick of top grasps at these (x, y, z) m in `base`, best first, over an empty world."""
+    world = CollisionChecker(EMPTY)
+    grasps = []
+    for x, y, z in where:
+        T = top_grasp(x, y, z)
+        grasps.append(Grasp(pose=T, width=0.05, ik=ik_tcp(T, dims.UR5_READY_Q)[0]))
+    return GraspSet(
+        group(grasps), (), world, world, np.array([g.pose[:3, 3] for g in grasps]), "gpd"
+    )
+
+
+@pytest.mark.parametrize("quick_way", [None, 1, 3])
+def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_long_search(
+    monkeypatch, quick_way
+) -> None:
+    """Five grasps, whose ways from ready to their pre-grasps only full searches find, but
+    for the one at `quick_way` (its place in the order), which a short search finds: that
+    one is taken, after the short searches of the grasps before it. Where no short search
+    finds a way, QUICK_MISSES of them are spent, and the full searches take the best grasp."""
+    searched: list[tuple[int, int]] = []  # (grasp, samples)
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(5)])
+    pres = [ik_tcp(pregrasp_pose(g.pose, 0.10), g.ik)[0] for g in found.ordered()]
+
+    def search(a, b, checker, rng, s, **kw):
+        k = next(k for k, pre in enumerate(pres, 1) if np.allclose(b, pre, atol=1e-6))
+        searched.append((k, s.rrt_max_samples))
+        quick = s.rrt_max_samples <= first_plan.QUICK_SAMPLES
+        return np.array([a, b], float) if not quick or k == quick_way else None
+
+    monkeypatch.setattr(joint_search, "joint_path", search)
+    s = get_settings().motion
+    plan, grasp, tried = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
+    assert not isinstance(plan, Failure), plan
+    short, full = first_plan.QUICK_SAMPLES, s.rrt_max_samples
+    if quick_way is None:
+        misses = first_plan.QUICK_MISSES
+        assert tried == 1 and grasp is found.ordered()[0]
+        assert searched == [(k, short) for k in range(1, misses + 1)] + [(1, full)]
+    else:
+        assert tried == quick_way and grasp is found.ordered()[quick_way - 1]
+        assert searched == [(k, short) for k in range(1, quick_way + 1)]
