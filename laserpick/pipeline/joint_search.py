@@ -24,12 +24,24 @@ from laserpick.pipeline.quicken import quicken
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import MotionSettings
 
-__all__ = ["BLIND_LEGS", "UNSEEN_SAMPLES", "Searches", "joint_path", "joint_path_via"]
+__all__ = [
+    "BLIND_LEGS",
+    "QUICKEN_TRIES",
+    "UNSEEN_SAMPLES",
+    "Searches",
+    "joint_path",
+    "joint_path_via",
+]
 
 #: The search that tells whether a blocked leg had a way through unseen space: its samples
 #: (a way is found in about 0.05 s where there is one), and how many legs it tries.
 UNSEEN_SAMPLES = 300
 BLIND_LEGS = 3
+#: Partial shortcuts `quicken` tries on a searched path: (empty hand, carrying). A carry is
+#: searched while the arm lifts, which covers most of the longer work; nearly every carry
+#: to the basket turns the elbow over and is searched. On 44 recorded carries, 200 more
+#: tries made them 0.8 s quicker to run (9.7 s to 8.9 s) for 0.5 s more search.
+QUICKEN_TRIES = {False: 40, True: 240}
 
 
 def joint_path(
@@ -61,7 +73,8 @@ def joint_path(
         return path
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
     carrying = kw.get("payload") is not None
-    quick = quicken(path, checker, rng, motion_limits(s, carrying=carrying), **kw)
+    limits, tries = motion_limits(s, carrying=carrying), QUICKEN_TRIES[carrying]
+    quick = quicken(path, checker, rng, limits, tries=tries, **kw)
     quick = shortcut(quick, checker, rng, **kw)
     # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
     return min((path, quick), key=lambda p: timed(p, s, carrying=carrying).duration)
