@@ -8,6 +8,9 @@ finds the same path, and the difference is the quickening alone.
 Record problems as for bench/planners.py (LASERPICK_RECORD_PLANS=DIR on any bench), then:
 
     .venv/bin/python bench/path_quickening.py /tmp/plans/isolation [/tmp/plans/...]
+
+--carry-tries N quickens the carries with N partial shortcuts instead of
+`joint_search.QUICKEN_TRIES`'s; --carries-only leaves the empty hand's searches out.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from laserpick.pipeline.joint_search import joint_path
+from laserpick.pipeline import joint_search
 from laserpick.pipeline.motion_limits import timed
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.rrt import rrt_connect, shortcut
@@ -29,7 +32,11 @@ from laserpick.settings import get_settings
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folders", nargs="+", type=Path, help="folders of recorded .npz problems")
+    ap.add_argument("--carry-tries", type=int, help="partial shortcuts a carry gets")
+    ap.add_argument("--carries-only", action="store_true", help="only problems that carry")
     args = ap.parse_args()
+    if args.carry_tries is not None:
+        joint_search.QUICKEN_TRIES[True] = args.carry_tries
     s = get_settings().motion.model_copy(update={"quicken_paths": True})
     files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
     rows = []
@@ -37,6 +44,8 @@ def main() -> None:
     for f in files:
         q0, q1, checker, kw = load_search(f)
         carry = kw.get("payload") is not None
+        if args.carries_only and not carry:
+            continue
         t = time.perf_counter()
         rng = np.random.default_rng(0)
         found = rrt_connect(
@@ -48,7 +57,7 @@ def main() -> None:
         searched = shortcut(found, checker, rng, **kw)
         t_searched = time.perf_counter() - t
         t = time.perf_counter()
-        quick = joint_path(q0, q1, checker, np.random.default_rng(0), s, **kw)
+        quick = joint_search.joint_path(q0, q1, checker, np.random.default_rng(0), s, **kw)
         t_quick = time.perf_counter() - t
         before = timed(searched, s, carrying=carry).duration
         after = timed(quick, s, carrying=carry).duration
