@@ -75,8 +75,8 @@ def plan_first(
 
     The grasps are planned with short searches first (`QUICK_SAMPLES`), until one plans or
     `QUICK_MISSES` of them found no way; then, where none planned, with full searches, best
-    first again: a grasp whose way is found at once is taken before a better-ranked one
-    whose way needs seconds of search, or none is there.
+    first again, the ways the short ones found kept: a grasp whose way is found at once is
+    taken before a better-ranked one whose way needs seconds of search, or none is there.
     From anywhere but the ready pose (stowed or standing by, mostly) the transit goes
     through a ready pose; from the stowed pose, through the unstow pose first; from standing
     by, through its exit where no ready pose is clear. From either, the way to the ready
@@ -97,10 +97,12 @@ def plan_first(
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     searches = Searches(s.rrt_max_failed)
     if s.rrt_max_samples > QUICK_SAMPLES:
-        quick = _quick_pass(found, grasps, q_now, rng, s, via, admit, searches)
-        if quick.grasp is not None:
-            place = next(k for k, g in enumerate(grasps, 1) if g is quick.grasp)
-            return quick.plan, quick.grasp, place
+        quick = Searches(QUICK_MISSES)
+        short = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})
+        done = _plan_in_order(found, grasps, q_now, rng, short, via, quick, admit)
+        if done.grasp is not None:
+            return done.plan, done.grasp, _place(grasps, done.grasp)
+        searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
     first = _plan_in_order(found, grasps, q_now, rng, s, via, searches, admit)
     last = first
     if first.grasp is None and first.no_way and not searches.spent:
@@ -108,31 +110,16 @@ def plan_first(
         again = (UR5_HIGH_READY_Q, *via[:1])
         last = _plan_in_order(found, first.no_way, q_now, rng, s, again, searches)
     if last.grasp is not None:
-        place = next(k for k, g in enumerate(grasps, 1) if g is last.grasp)
-        return last.plan, last.grasp, place
+        return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
     if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
         plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
     return plan, None, first.tried
 
 
-def _quick_pass(
-    found: GraspSet,
-    grasps: Sequence[Grasp],
-    q_now: np.ndarray,
-    rng: np.random.Generator,
-    s: MotionSettings,
-    via: Sequence[np.ndarray],
-    admit: Callable[[Grasp], Failure | None] | None,
-    searches: Searches,
-) -> _Pass:
-    """`_plan_in_order` with searches of QUICK_SAMPLES, stopped after QUICK_MISSES of them
-    found no way. The legs it found are kept in the full `searches`."""
-    quick = Searches(QUICK_MISSES)
-    limits = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})
-    done = _plan_in_order(found, grasps, q_now, rng, limits, via, quick, admit)
-    searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
-    return done
+def _place(grasps: Sequence[Grasp], grasp: Grasp) -> int:
+    """The place (from 1) of `grasp` in `grasps`."""
+    return next(k for k, g in enumerate(grasps, 1) if g is grasp)
 
 
 @dataclass
