@@ -123,16 +123,17 @@ def _grasps_pick(*where: tuple[float, float, float]) -> GraspSet:
     )
 
 
-@pytest.mark.parametrize("quick_way", [None, 1, 3])
+@pytest.mark.parametrize("quick_way", [None, 1, 5])
 def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_long_search(
     monkeypatch, quick_way
 ) -> None:
-    """Five grasps, whose ways from ready to their pre-grasps only full searches find, but
+    """Eight grasps, whose ways from ready to their pre-grasps only full searches find, but
     for the one at `quick_way` (its place in the order), which a short search finds: that
     one is taken, after the short searches of the grasps before it. Where no short search
-    finds a way, QUICK_MISSES of them are spent, and the full searches take the best grasp."""
+    finds a way, as many as the full searches may fail (`rrt_max_failed`) are spent, and
+    the full searches take the best grasp."""
     searched: list[tuple[int, int]] = []  # (grasp, samples)
-    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(5)])
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(8)])
     pres = [ik_tcp(pregrasp_pose(g.pose, 0.10), g.ik)[0] for g in found.ordered()]
 
     def search(a, b, checker, rng, s, **kw):
@@ -147,7 +148,7 @@ def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_lon
     assert not isinstance(plan, Failure), plan
     short, full = first_plan.QUICK_SAMPLES, s.rrt_max_samples
     if quick_way is None:
-        misses = first_plan.QUICK_MISSES
+        misses = s.rrt_max_failed
         assert tried == 1 and grasp is found.ordered()[0]
         assert searched == [(k, short) for k in range(1, misses + 1)] + [(1, full)]
     else:

@@ -25,7 +25,6 @@ from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
 __all__ = [
-    "QUICK_MISSES",
     "QUICK_SAMPLES",
     "READY_TOLERANCE",
     "UNSEEN_WAYS",
@@ -42,12 +41,12 @@ UNSEEN_WAYS = (
     " they saw"
 )
 #: The short search each grasp's transit gets first (samples; a way that exists is mostly
-#: found within it, in about 0.1 s), and the short searches that may find none before the
-#: full searches start: a juice bottle on a high table spent three full searches (12 s on a
-#: loaded machine) on grasps whose way up past the board was not found, before the fourth
-#: grasp's way was found at once.
+#: found within it, in about 0.1 s): a juice bottle on a high table spent three full
+#: searches (12 s on a loaded machine) on grasps whose way up past the board was not
+#: found, before the fourth grasp's way was found at once. The short searches may miss as
+#: often as the full ones may fail (`rrt_max_failed`): stopped after three, they never
+#: reached that fourth grasp.
 QUICK_SAMPLES = 300
-QUICK_MISSES = 3
 
 
 def at_pose(q: np.ndarray | None, pose: np.ndarray) -> bool:
@@ -74,7 +73,7 @@ def plan_first(
     says why (what comes after the pick needs of it).
 
     The grasps are planned with short searches first (`QUICK_SAMPLES`), until one plans or
-    `QUICK_MISSES` of them found no way; then, where none planned, with full searches, best
+    `rrt_max_failed` of them found no way; then, where none planned, with full searches, best
     first again, the ways the short ones found kept: a grasp whose way is found at once is
     taken before a better-ranked one whose way needs seconds of search, or none is there.
     From anywhere but the ready pose (stowed or standing by, mostly) the transit goes
@@ -97,7 +96,7 @@ def plan_first(
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     searches = Searches(s.rrt_max_failed)
     if s.rrt_max_samples > QUICK_SAMPLES:
-        quick = Searches(QUICK_MISSES)
+        quick = Searches(s.rrt_max_failed)
         short = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})
         done = _plan_in_order(found, grasps, q_now, rng, short, via, quick, admit)
         if done.grasp is not None:
