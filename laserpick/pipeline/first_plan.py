@@ -44,8 +44,7 @@ UNSEEN_WAYS = (
 #: found within it, in about 0.1 s): a juice bottle on a high table spent three full
 #: searches (12 s on a loaded machine) on grasps whose way up past the board was not
 #: found, before the fourth grasp's way was found at once. The short searches may miss as
-#: often as the full ones may fail (`rrt_max_failed`): stopped after three, they never
-#: reached that fourth grasp.
+#: often as the full ones may fail (`rrt_max_failed`).
 QUICK_SAMPLES = 300
 
 
