@@ -1,8 +1,9 @@
 """What the partial shortcuts of `pipeline/quicken.py` save, on recorded joint-space search
 problems: per problem, the timed duration of our search's path (RRT-Connect and vertex
 joins, as `joint_search.joint_path` had it before) and of the path it returns now,
-each timed at the speed its motion runs at (the carry's where the problem carries an
-object), and the wall-clock time each took. Both start from the same seed, so the search
+each timed as the arm runs it (at the carry's limits where the problem carries an object,
+its corners blended where the problem's own check passes them), and the wall-clock time
+each took. Both start from the same seed, so the search
 finds the same path, and the difference is the quickening alone.
 
 Record problems as for bench/planners.py (LASERPICK_RECORD_PLANS=DIR on any bench), then:
@@ -59,8 +60,12 @@ def main() -> None:
         t = time.perf_counter()
         quick = joint_search.joint_path(q0, q1, checker, np.random.default_rng(0), s, **kw)
         t_quick = time.perf_counter() - t
-        before = timed(searched, s, carrying=carry).duration
-        after = timed(quick, s, carrying=carry).duration
+
+        def clear(Q: np.ndarray, checker=checker, kw=kw) -> np.ndarray:
+            return checker.clearance_ok(Q, **kw)
+
+        before = timed(searched, s, carrying=carry, clear=clear).duration
+        after = timed(quick, s, carrying=carry, clear=clear).duration
         rows.append((before, after, t_searched, t_quick))
         times = f"{t_searched:6.2f}, {t_quick:.2f}"
         print(f"{f.stem}  {carry!s:5}  {before:10.2f}  {after:11.2f}  {times}")

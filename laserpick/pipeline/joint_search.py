@@ -20,7 +20,7 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
-from laserpick.pipeline.quicken import quicken
+from laserpick.pipeline.quicken import merge_short_legs, quicken
 from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import MotionSettings
 
@@ -55,7 +55,8 @@ def joint_path(
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
     OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
-    shortcuts (`quicken`) where the timing says so. None at once when the start or the goal
+    shortcuts (`quicken`) and rid of its short legs (`merge_short_legs`) where the timing
+    says so. None at once when the start or the goal
     is not clear: no edge can leave it, and the search would spend all its samples (seconds)
     finding that out.
 
@@ -75,10 +76,16 @@ def joint_path(
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
     carrying = kw.get("payload") is not None
     limits, tries = motion_limits(s, carrying=carrying), QUICKEN_TRIES[carrying]
-    quick = quicken(path, checker, rng, limits, tries=tries, **kw)
-    quick = shortcut(quick, checker, rng, **kw)
-    # The estimate `quicken` goes by leaves out the corners; the timing itself decides.
-    return min((path, quick), key=lambda p: timed(p, s, carrying=carrying).duration)
+    quick = shortcut(quicken(path, checker, rng, limits, tries=tries, **kw), checker, rng, **kw)
+    merged = merge_short_legs(quick, checker, **kw)
+
+    def clear(Q: np.ndarray) -> np.ndarray:  # as the arm's timing blends the corners
+        return checker.clearance_ok(Q, **kw)
+
+    # The estimate `quicken` goes by leaves out the corners; the arm's own timing decides,
+    # its corners blended where this search's check passes (`GuardedMotion.follow`).
+    ways = (path, quick) if len(merged) == len(quick) else (path, quick, merged)
+    return min(ways, key=lambda p: timed(p, s, carrying=carrying, clear=clear).duration)
 
 
 def _search(

@@ -8,7 +8,10 @@ joint alone.
 A change is kept only where it is clear by the same check as the search's, and quicker by
 `run_time`, the time the path takes at the joint speed limit, the TCP speed cap or the
 hand's turning cap, whichever binds on each segment: what the arm's timing spends
-(`timing`), less its accelerations. Frames: joint angles in rad; TCP in `base`, m.
+(`timing`), less its accelerations. That estimate leaves out the corners, and each partial
+shortcut adds two; where a leg between corners is short, the blends at its ends may reach
+no further than half of it and the arm all but stops at each (`smoothing`): such legs are
+taken out afterwards (`merge_short_legs`). Frames: joint angles in rad; TCP in `base`, m.
 """
 
 from __future__ import annotations
@@ -20,13 +23,17 @@ import numpy as np
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.timing import Limits, straight_times
 
-__all__ = ["quicken", "run_time"]
+__all__ = ["SHORT_LEG", "merge_short_legs", "quicken", "run_time"]
 
 #: Points along each segment at which the TCP's path is measured: a joint-space segment
 #: moves the TCP along an arc, not a chord.
 ARC_SAMPLES = 6
 #: A change must save at least this (s): smaller ones only add vertices.
 LEAST_GAIN = 0.02
+#: Legs shorter than this (rad, joint space) `merge_short_legs` takes out. On 72 carries
+#: recorded in `in-situ`, timed as the arm runs them: 7.53 s as searched and quickened;
+#: 7.16, 7.15 and 7.14 s with legs under 0.35, 0.5 and 0.8 rad taken out.
+SHORT_LEG = 0.5
 
 
 def _segment_times(path: np.ndarray, limits: Limits) -> np.ndarray:
@@ -89,3 +96,41 @@ def quicken(
             path[-1] = end
             times = _segment_times(path, limits)
     return path
+
+
+def merge_short_legs(
+    path: np.ndarray, checker: CollisionChecker, *, shortest: float = SHORT_LEG, **kw
+) -> np.ndarray:
+    """`path` (K, 6) rad with its legs shorter than `shortest` (rad) taken out where
+    `checker.segment_ok(..., **kw)` allows, the shortest first: a corner at one of its ends
+    dropped where the legs beside it join clear, else its two corners merged into the leg's
+    middle where the legs to it are clear. The ends stay where they are."""
+    path = np.array(path, float)
+    while len(path) > 2:
+        merged = _merge_shortest(path, checker, shortest, kw)
+        if merged is None:
+            break
+        path = merged
+    return path
+
+
+def _merge_shortest(
+    path: np.ndarray, checker: CollisionChecker, shortest: float, kw: dict
+) -> np.ndarray | None:
+    """`path` with its shortest leg under `shortest` (rad) that the check lets go taken out
+    (`merge_short_legs`), or None where there is none."""
+    length = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    last = len(path) - 1
+    for k in np.argsort(length, kind="stable"):
+        if length[k] >= shortest:
+            break
+        for drop in (k, k + 1):  # a corner at either end of leg k, joined past
+            if 0 < drop < last and checker.segment_ok(path[drop - 1], path[drop + 1], **kw):
+                return np.delete(path, drop, axis=0)
+        if k > 0 and k + 1 < last:
+            middle = (path[k] + path[k + 1]) / 2
+            if checker.segment_ok(path[k - 1], middle, **kw) and checker.segment_ok(
+                middle, path[k + 2], **kw
+            ):
+                return np.vstack([path[:k], middle, path[k + 2 :]])
+    return None
