@@ -85,12 +85,23 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     found = find_grasps(perception, dims.UR5_READY_Q, q_capture=robot.joint_state().q)
     assert isinstance(found, GraspSet), found
     b = Behaviours(robot)
+    searching: list[bool] = []  # at each motion the pick starts, whether the carry is searched
+    execute = robot.execute
+
+    def noting(traj):
+        searching.append(b.ahead is not None)
+        return execute(traj)
+
+    robot.execute = noting  # type: ignore[method-assign]
     out = b.pick(found, to_basket=True)  # the screen admits a grasp the drop can use
+    robot.execute = execute  # type: ignore[method-assign]
     assert out.ok, out.failure
     assert referee.object_at(out.grasp.position) == name
     assert robot.gripper_state().holding
     assert referee.position(name)[2] > TABLE_TOP + 0.08, "lifted"
-    # The carry was searched while the arm lifted, from where the lift left it.
+    # The carry was searched from the moment the pick was planned, from where the lift
+    # left the arm: while the arm moved in, grasped and lifted.
+    assert searching and all(searching), searching
     tolerance = b.settings.behaviour.start_tolerance
     owners = (basket_way, b.held, b.held.surroundings)
     assert b.ahead is not None and b.ahead.fits(owners, robot.joint_state().q, tolerance)
@@ -105,7 +116,6 @@ def test_marked_object_is_picked_and_dropped_in_the_basket(robot):
     assert not robot.gripper_state().closed
     # Then home, the way it came out: through the unstow pose.
     passed: list[float] = []
-    execute = robot.execute
 
     def recording(traj):
         passed.append(float(np.abs(traj.q - dims.UR5_UNSTOW_Q).max(axis=1).min()))

@@ -85,6 +85,7 @@ def test_pick_into_an_unseen_obstacle_stops_and_backs_off(robot):
     assert np.abs(s.arm_qd).max() < 0.05
     assert tcp_pose(s.arm_q)[2, 3] > TABLE_TOP + 0.03, "it backed off upward"
     assert not s.gripper_closed
+    assert b.ahead is None and b.held is None, "the carry searched for it is dropped"
 
 
 def test_an_object_that_leaves_the_hand_as_the_lift_ends_is_said_to_have_slipped(robot):
