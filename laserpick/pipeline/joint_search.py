@@ -77,15 +77,14 @@ def joint_path(
     carrying = kw.get("payload") is not None
     limits, tries = motion_limits(s, carrying=carrying), QUICKEN_TRIES[carrying]
     quick = shortcut(quicken(path, checker, rng, limits, tries=tries, **kw), checker, rng, **kw)
-    merged = merge_short_legs(quick, checker, **kw)
+    quick = merge_short_legs(quick, checker, **kw)
 
     def clear(Q: np.ndarray) -> np.ndarray:  # as the arm's timing blends the corners
         return checker.clearance_ok(Q, **kw)
 
     # The estimate `quicken` goes by leaves out the corners; the arm's own timing decides,
     # its corners blended where this search's check passes (`GuardedMotion.follow`).
-    ways = (path, quick) if len(merged) == len(quick) else (path, quick, merged)
-    return min(ways, key=lambda p: timed(p, s, carrying=carrying, clear=clear).duration)
+    return min((path, quick), key=lambda p: timed(p, s, carrying=carrying, clear=clear).duration)
 
 
 def _search(
