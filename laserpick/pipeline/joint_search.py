@@ -56,9 +56,8 @@ def joint_path(
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
     OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
     shortcuts (`quicken`) and rid of its short legs (`merge_short_legs`) where the timing
-    says so. None at once when the start or the goal
-    is not clear: no edge can leave it, and the search would spend all its samples (seconds)
-    finding that out.
+    says so. None at once when the start or the goal is not clear: no edge can leave it,
+    and the search would spend all its samples (seconds) finding that out.
 
     q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
     else a search toward those that are clear (`_search`), which ends at the goal it reaches.
