@@ -3,8 +3,8 @@ problems: per problem, the timed duration of our search's path (RRT-Connect and 
 joins, as `joint_search.joint_path` had it before) and of the path it returns now,
 each timed as the arm runs it (at the carry's limits where the problem carries an object,
 its corners blended where the problem's own check passes them), and the wall-clock time
-each took. Both start from the same seed, so the search
-finds the same path, and the difference is the quickening alone.
+each took. Both start from the same seed, so the search finds the same path, and the
+difference is the quickening alone.
 
 Record problems as for bench/planners.py (LASERPICK_RECORD_PLANS=DIR on any bench), then:
 

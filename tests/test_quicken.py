@@ -64,7 +64,7 @@ def test_no_change_is_kept_that_the_check_refuses():
         runs, searched_runs = (timed(p, s, clear=checker.clearance_ok) for p in (path, searched))
         assert runs.duration <= searched_runs.duration
         saved += searched_runs.duration - runs.duration
-    assert saved > 0.3  # 1.4 s over the three seeds
+    assert saved > 0.3  # 0.66 s over the three seeds, as the arm runs them
 
 
 def _with_short_legs() -> np.ndarray:
@@ -73,8 +73,8 @@ def _with_short_legs() -> np.ndarray:
     q0 = ik_tcp(top_grasp(1.6, -0.5, 0.75), dims.UR5_READY_Q)[0]
     q1 = ik_tcp(top_grasp(1.6, 0.1, 0.75), dims.UR5_READY_Q)[0]
     bend = np.array([0.0, 0.3, -0.3, 0.0, 0.0, 0.4])
-    a, b = q0 + 0.45 * (q1 - q0) + bend, q0 + 0.45 * (q1 - q0) + bend
-    b[0] += 0.1
+    a = q0 + 0.45 * (q1 - q0) + bend
+    b = a + np.array([0.1, 0.0, 0.0, 0.0, 0.0, 0.0])
     return np.array([q0, a, b, q1 - 0.05 * (q1 - q0) / np.linalg.norm(q1 - q0), q1])
 
 
