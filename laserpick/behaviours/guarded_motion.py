@@ -7,6 +7,7 @@ controller message."""
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from collections.abc import Callable, Sequence
@@ -168,10 +169,7 @@ class GuardedMotion:
         check it was searched with (`checker`, kw) passes, within the carrying limits where
         kw has a `payload`."""
         carrying = kw.get("payload") is not None
-
-        def clear(Q: np.ndarray) -> np.ndarray:  # the check the legs were searched with
-            return checker.clearance_ok(Q, **kw)
-
+        clear = functools.partial(checker.clearance_ok, **kw)  # the legs' search's own check
         return self.run(timed(path, self.settings.motion, carrying=carrying, clear=clear), what)
 
     def descend(

@@ -10,6 +10,7 @@ Frames: joint angles in rad.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -77,12 +78,9 @@ def joint_path(
     limits, tries = motion_limits(s, carrying=carrying), QUICKEN_TRIES[carrying]
     quick = shortcut(quicken(path, checker, rng, limits, tries=tries, **kw), checker, rng, **kw)
     quick = merge_short_legs(quick, checker, **kw)
-
-    def clear(Q: np.ndarray) -> np.ndarray:  # as the arm's timing blends the corners
-        return checker.clearance_ok(Q, **kw)
-
     # The estimate `quicken` goes by leaves out the corners; the arm's own timing decides,
     # its corners blended where this search's check passes (`GuardedMotion.follow`).
+    clear = functools.partial(checker.clearance_ok, **kw)
     return min((path, quick), key=lambda p: timed(p, s, carrying=carrying, clear=clear).duration)
 
 
