@@ -12,12 +12,12 @@ Frames: points in `base` (m); each DepthFrame carries its pose in `base` and its
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Sequence
 
 import numpy as np
 
 from laserpick.description.dims import GRIPPER_HAND
+from laserpick.pipeline.frame_stack import MIN_RANGE, frame_stack
 from laserpick.settings import GraspSettings
 from laserpick.transforms import pinhole_project
 from laserpick.types import DepthFrame, Grasp
@@ -27,8 +27,6 @@ from laserpick.types import DepthFrame, Grasp
 #: from the tip). Its middle along the closing axis: the pad and plate's middle.
 PROBE_ACROSS = (-0.6, 0.0, 0.6)
 PROBE_DOWN = (0.15, 0.5, 0.85)
-#: Nearest a probe may be to a camera (m) to count: the sensors' minimum range.
-MIN_RANGE = 0.1
 #: How near (px) to its image's border a target point projects for that camera's view to
 #: end there. The fused cloud keeps every second pixel and none on the border, so the last
 #: points lie 2-4 px in: a lying juice bottle on the 108 cm table ended 4 px inside the high
@@ -46,10 +44,6 @@ CUT_MIN_POINTS = 5
 ALL_AT_ONCE_MAX = 30_000
 ONE_BY_ONE = 4
 AT_ONCE_MAX = 100_000
-#: Stacks kept: a pick asks of its capture's frames (with the views from the way in)
-#: thousands of times, and grasp detection of its own. Each holds a copy of its frames'
-#: depth images (45 frames of 640 x 480: 55 MB).
-STACKS_KEPT = 2
 #: The longest (m) an object the hand carries is taken to be where the cameras' view cut it
 #: off (the kitchen's longest, the juice bottle, is 20.6 cm).
 OBJECT_SPAN_MAX = 0.25
@@ -79,7 +73,7 @@ def seen_free(
     # All at once where the pairs are few: a search held to seen space asks about tens to
     # hundreds of points thousands of times, and per frame asked, the calls cost more than
     # the arithmetic (60 points of 45 frames: 0.06 ms, against 0.9 ms frame by frame).
-    stack = _stack(frames)
+    stack = frame_stack(frames)
     if len(points) * len(frames) <= ALL_AT_ONCE_MAX:
         return stack.seen_past(points, tolerance)
     free = np.zeros(len(points), bool)
@@ -93,63 +87,6 @@ def seen_free(
         free[todo] = stack.seen_past(points[todo], tolerance[todo], k, k + 1)
         todo = todo[~free[todo]]
     return free
-
-
-class _FrameStack:
-    """Depth frames asked all at once: their images (H, W; m) in one flat buffer, each from
-    its offset, and one matrix that takes a point of `base` to every frame's homogeneous pixel
-    at once (`projection`)."""
-
-    def __init__(self, frames: Sequence[DepthFrame]) -> None:
-        self.frames = tuple(frames)  # kept, so that the ids that key the cache stay theirs
-        self.size = np.array([f.depth.shape for f in frames])  # (F, 2): h, w
-        self.depths = np.concatenate([f.depth.ravel() for f in frames])
-        self.offset = np.concatenate([[0], np.cumsum(self.size.prod(axis=1))[:-1]])
-        # Each frame's K [R^T | -R^T t], as (4, 3F): a point's homogeneous pixel in every
-        # frame is one product, (x, y, z, 1) times it. Its pixels match `pinhole_project`'s
-        # (none of 5.8 million differed on a kitchen capture; depths within 1e-15 m).
-        K = np.array([f.K for f in frames], np.float64)
-        T = np.array([f.T_base_cam for f in frames], np.float64)
-        R_t = np.transpose(T[:, :3, :3], (0, 2, 1))
-        rows = np.concatenate([K @ R_t, -(K @ R_t @ T[:, :3, 3:])], axis=2)  # (F, 3, 4)
-        self.projection = rows.reshape(-1, 4).T.copy()
-
-    def seen_past(
-        self, points: np.ndarray, tolerance: np.ndarray, first: int = 0, last: int | None = None
-    ) -> np.ndarray:
-        """(N,) `seen_free` of points (N, 3) (m, `base`) with `tolerance` (N,) (m) in the
-        frames `first` to `last` (default: all the rest), in one product and one gather:
-        each point's pixel and depth in each frame, and the depth read there."""
-        last = len(self.frames) if last is None else last
-        cols = self.projection[:, 3 * first : 3 * last]
-        pixel = (points @ cols[:3] + cols[3]).reshape(len(points), last - first, 3)
-        z = pixel[..., 2]
-        ahead = z > MIN_RANGE
-        depth = np.where(ahead, z, 1.0)
-        u = np.rint(pixel[..., 0] / depth).astype(np.int64)
-        v = np.rint(pixel[..., 1] / depth).astype(np.int64)
-        h, w = self.size[first:last, 0], self.size[first:last, 1]
-        n, f = np.nonzero(ahead & (u >= 0) & (u < w) & (v >= 0) & (v < h))
-        at = self.offset[first + f] + v[n, f] * w[f] + u[n, f]
-        free = np.zeros(len(points), bool)
-        free[n[self.depths[at] > z[n, f] + tolerance[n]]] = True
-        return free
-
-
-_STACKS: dict[tuple[int, ...], _FrameStack] = {}
-_STACKS_LOCK = threading.Lock()
-
-
-def _stack(frames: Sequence[DepthFrame]) -> _FrameStack:
-    """The frames' intrinsics and poses stacked (`_FrameStack`) once while they are asked:
-    the last STACKS_KEPT are kept (the carry's search ahead asks from its own thread)."""
-    key = tuple(map(id, frames))
-    with _STACKS_LOCK:
-        stack = _STACKS.pop(key, None) or _FrameStack(frames)
-        _STACKS[key] = stack
-        while len(_STACKS) > STACKS_KEPT:
-            del _STACKS[next(iter(_STACKS))]
-    return stack
 
 
 def hidden(points: np.ndarray, frames: Sequence[DepthFrame], tolerance: float) -> np.ndarray:
