@@ -26,9 +26,9 @@ MIN_RANGE = 0.1
 #: 480: 55 MB).
 STACKS_KEPT = 2
 #: Buffers of stacks let go that no one asks any more, kept for the next stacks to fill: a
-#: new 55 MB buffer is paged in (transparent huge pages compacted) at every pick, 0.1-0.35 s
-#: of its planning on a loaded 2-core machine, a buffer filled again 0.02 s. A stack takes
-#: a spare at most SPARE_SLACK times the length it needs.
+#: new 55 MB buffer is paged in (transparent huge pages compacted) at every pick, 0.02-0.32 s
+#: of its planning in an `in-situ` bench, a buffer filled again 0.014 s. A stack takes a
+#: spare at most SPARE_SLACK times the length it needs.
 SPARES_KEPT = STACKS_KEPT
 SPARE_SLACK = 2
 
