@@ -92,15 +92,19 @@ def sweep(path: np.ndarray) -> float:
 
 def counting(checker: CollisionChecker) -> list[int]:
     """Count the configurations `checker` is asked about (a measure of a search's work that,
-    unlike its wall-clock time, does not depend on the machine's load)."""
+    unlike its wall-clock time, does not depend on the machine's load), through either of
+    its checks: `clearance_ok` for configurations, `all_clear` for a segment's."""
     checked = [0]
-    clearance_ok = checker.clearance_ok
 
-    def counted(Q, **kw):
-        checked[0] += len(np.atleast_2d(Q))
-        return clearance_ok(Q, **kw)
+    def counted(check):
+        def count(Q, **kw):
+            checked[0] += len(np.atleast_2d(Q))
+            return check(Q, **kw)
 
-    checker.clearance_ok = counted  # type: ignore[method-assign]
+        return count
+
+    checker.clearance_ok = counted(checker.clearance_ok)  # type: ignore[method-assign]
+    checker.all_clear = counted(checker.all_clear)  # type: ignore[method-assign]
     return checked
 
 

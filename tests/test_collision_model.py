@@ -342,3 +342,41 @@ def test_the_broad_phases_change_no_verdict():
         apart = ~(gap < SPHERES.radius[upper] + PAYLOAD_POINT_RADIUS + margin).any(axis=(1, 2))
         assert 0 < apart.sum() < len(Q)
         assert np.array_equal(off_upper_links(sphere_centres(frames), held, margin), apart)
+
+
+def test_the_stopping_check_and_the_cloud_balls_change_no_verdict():
+    """`all_clear` stops at the first test that finds a configuration blocked, and the
+    cloud is asked about a held object's points only where their ball comes near it: over
+    segments all over the joint space, with and without the hand, carrying a box or not,
+    the verdicts are those of measuring every sphere and every point against every point of
+    the cloud, the floor and the boxes."""
+    rng = np.random.default_rng(11)
+    xs, ys = np.meshgrid(np.linspace(0.9, 1.8, 40), np.linspace(-0.8, 0.8, 60))
+    table = np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, 0.73)])
+    checker = CollisionChecker(table, voxel=0.0)
+    payload = box_points((0.19, 0.06, 0.24), step=0.03)
+    lo, hi = np.maximum(dims.UR5_Q_MIN, -math.pi), np.minimum(dims.UR5_Q_MAX, math.pi)
+    verdicts = set()
+    for k in range(400):
+        Q = np.linspace(*rng.uniform(lo, hi, (2, 6)), 3)
+        kw = {"hand": k % 2 == 0, "payload": payload if k % 3 == 0 else None}
+        clear = checker.clearance_ok(Q, **kw)
+        assert checker.all_clear(Q, **kw) == clear.all()
+        frames = body_frames(Q)
+        keep = np.ones(len(SPHERES.radius), bool) if kw["hand"] else ~SPHERES.hand
+        centres, radius = sphere_centres(frames)[:, keep], SPHERES.radius[keep]
+        body, apart = SPHERES.body[keep], np.ones(len(Q), bool)
+        if kw["payload"] is not None:
+            held = held_points(frames, payload)
+            apart = off_upper_links(sphere_centres(frames), held, checker.margin)
+            centres = np.concatenate([centres, held], axis=1)
+            radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
+            body = np.append(body, np.full(len(payload), HAND_BODY))
+        reach = radius + checker.margin
+        gap = np.linalg.norm(centres[:, :, None] - checker.points[None, None], axis=-1)
+        hit = (gap.min(axis=2) < reach).any(axis=1)
+        hit |= (centres[..., 2] < radius + checker.floor_clearance).any(axis=1)
+        hit |= ((box_gaps(centres) < reach[:, None]) & BOX_CHECKS[body]).any(axis=(1, 2))
+        assert np.array_equal(clear, apart & ~hit)
+        verdicts |= {tuple(clear)}
+    assert len(verdicts) > 4  # clear, blocked and mixed segments were met

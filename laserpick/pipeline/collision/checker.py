@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from laserpick.description.shapes import FLOOR_CLEARANCE, KEEPOUT_BOXES, body_frames
 from laserpick.pipeline.collision.arm_spheres import HAND_BODY, SPHERES, sphere_centres
-from laserpick.pipeline.collision.broad_phase import Ball, balls
+from laserpick.pipeline.collision.broad_phase import BodyBalls, body_balls
 from laserpick.pipeline.collision.carried import (
     PAYLOAD_POINT_RADIUS,
     coarse_payload,
@@ -27,6 +27,9 @@ from laserpick.pipeline.collision.obstacles import obstacle_mask
 from laserpick.pipeline.collision.seen_space import OWN_SPACE_PADDING, OwnSpace, unseen_spheres
 from laserpick.types import DepthFrame
 
+#: Spheres of one body worth a ball against the cloud (a hand and what it holds): a
+#: link's few are asked of the KD-tree at once, quicker than bounding them first.
+CLOUD_BALL_MIN = 32
 #: A joint segment's every this-many-th configuration is checked before the rest.
 SEGMENT_COARSE = 8
 #: Halvings of the margin that find the clearance a configuration keeps (`clearance_kept`):
@@ -115,18 +118,40 @@ class CollisionChecker:
         cameras' view (a bookshelf's board); the shoulder and upper arm stay below and beside
         the sensor posts, where no camera looks, so they are not held to it.
         """
+        return self._ok(Q, hand, payload, margin, seen, stop=False)
+
+    def all_clear(self, Q: np.ndarray, **kw) -> bool:
+        """Whether every configuration of Q (B, 6) (rad) collides with nothing
+        (`clearance_ok`'s options `kw`), the check stopping at the first test that finds one
+        that does: three of four segments a search tries are blocked, most at their first
+        configurations, and there every further test was work for nothing."""
+        return bool(self._ok(Q, stop=True, **kw).all())
+
+    def _ok(
+        self,
+        Q: np.ndarray,
+        hand: bool = True,
+        payload: np.ndarray | None = None,
+        margin: float | None = None,
+        seen: bool = False,
+        *,
+        stop: bool,
+    ) -> np.ndarray:
+        """`clearance_ok`; with `stop`, only `.all()` of what it returns is the verdict
+        (`_clear`)."""
         margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
+        frames = body_frames(Q)
         if payload is None or len(payload) == 0:
-            return self._clear(Q, hand, None, margin, seen)
+            return self._clear(frames, hand, None, margin, seen, stop)
         coarse = self._coarse_of(payload)
         if len(coarse) == len(payload):
-            return self._clear(Q, hand, payload, margin, seen)
+            return self._clear(frames, hand, payload, margin, seen, stop)
         # Exact: what does not clear some of the object's points does not clear them all.
-        clear = self._clear(Q, hand, coarse, margin, seen=False)
+        clear = self._clear(frames, hand, coarse, margin, False, stop)
         rows = np.flatnonzero(clear)
-        if len(rows):
-            clear[rows] = self._clear(Q[rows], hand, payload, margin, seen)
+        if len(rows) and not (stop and len(rows) < len(Q)):
+            clear[rows] = self._clear(frames[rows], hand, payload, margin, seen, stop)
         return clear
 
     def _coarse_of(self, payload: np.ndarray) -> np.ndarray:
@@ -141,34 +166,55 @@ class CollisionChecker:
 
     def _clear(
         self,
-        Q: np.ndarray,
+        frames: np.ndarray,
         hand: bool,
         payload: np.ndarray | None,
         margin: float,
         seen: bool,
+        stop: bool = False,
     ) -> np.ndarray:
-        """`clearance_ok` of configurations Q (B, 6) (rad) with every point of `payload`."""
-        frames = body_frames(Q)
+        """`clearance_ok` of the configurations whose body frames (B, 7, 4, 4) are `frames`
+        (`body_frames`), with every point of `payload`. stop: return once a test finds a
+        configuration blocked; the configurations it had not asked about yet read clear, so
+        only `.all()` of what returns is the verdict."""
         spheres = sphere_centres(frames)
         centres, radius, body = spheres, SPHERES.radius, SPHERES.body
         if not hand:
             keep = ~SPHERES.hand
             centres, radius, body = centres[:, keep], radius[keep], body[keep]
-        clear = np.ones(len(Q), bool)
+        clear = np.ones(len(frames), bool)
         if payload is not None and len(payload):
             held = held_points(frames, payload)
             clear &= off_upper_links(spheres, held, margin)
             centres = np.concatenate([centres, held], axis=1)
             radius = np.append(radius, np.full(len(payload), PAYLOAD_POINT_RADIUS))
             body = np.append(body, np.full(len(payload), HAND_BODY))
-        clear &= ~self._hits(centres, radius, body, margin).any(axis=1)
+        if stop and not clear.all():
+            return clear
+        for blocked in self._blocked(centres, radius, body, margin):
+            clear &= ~blocked
+            if stop and not clear.all():
+                return clear
         rows = np.flatnonzero(clear) if seen and self.frames else np.zeros(0, int)
-        if len(rows):  # only the configurations still clear: this projects into every camera
+        if len(rows) and not (stop and len(rows) < len(frames)):
+            # Only the configurations still clear: this projects into every camera.
             out = body == HAND_BODY
             spheres = centres[rows][:, out].reshape(-1, 3)
             blind = self.unseen(spheres, np.tile(radius[out], len(rows)))
             clear[rows[blind.reshape(len(rows), -1).any(axis=1)]] = False
         return clear
+
+    def _blocked(
+        self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float
+    ) -> Iterator[np.ndarray]:
+        """(B,) whether each configuration's spheres (B, S), of `radius` (S,) on the arm's
+        `body` (S,), come within `margin` of the floor, of a keep-out box, of the cloud: one
+        test at a time, the cheapest first, as `_clear` asks for them."""
+        reach = radius + margin
+        yield self._below_floor(centres, radius, margin).any(axis=1)
+        balls = body_balls(centres, reach, body)
+        yield box_contacts(centres, reach, body, balls).any(axis=(1, 2))
+        yield self._near_cloud(centres, reach, balls).any(axis=1)
 
     def clearance_kept(
         self, q: np.ndarray, *, hand: bool = True, steps: int = CLEARANCE_STEPS
@@ -248,44 +294,40 @@ class CollisionChecker:
         below the floor's clearance (B, S), within `margin` of each keep-out box that checks
         its body (B, S, K), and of the cloud (B, S)."""
         reach = radius + margin
+        balls = body_balls(centres, reach, body)
+        boxes = box_contacts(centres, reach, body, balls)
+        floor = self._below_floor(centres, radius, margin)
+        return floor, boxes, self._near_cloud(centres, reach, balls)
+
+    def _below_floor(self, centres: np.ndarray, radius: np.ndarray, margin: float) -> np.ndarray:
+        """(B, S) whether each sphere, at centres (B, S, 3) (m) of `radius` (S,) (m), comes
+        nearer the floor than its clearance, or than `margin` where that is negative."""
         # A negative margin (the hand at its grasp may touch the support) holds for the
         # floor too: for an object on the floor, the floor is the support.
         clearance = self.floor_clearance if margin >= 0 else margin
-        floor = centres[..., 2] < radius + clearance
-        few, bounded = balls(centres, reach, body)
-        boxes = box_contacts(centres, reach, body, (few, bounded))
-        return floor, boxes, self._near_cloud(centres, reach, few, bounded)
+        return centres[..., 2] < radius + clearance
 
-    def _near_cloud(
-        self, centres: np.ndarray, reach: np.ndarray, few: np.ndarray, bounded: list[Ball]
-    ) -> np.ndarray:
+    def _near_cloud(self, centres: np.ndarray, reach: np.ndarray, balls: BodyBalls) -> np.ndarray:
         """(B, S) whether each sphere, at centres (B, S, 3) (m), comes within its `reach`
-        (S,) (m) of the cloud: the `few` one by one, the spheres of each `bounded` ball
-        only where the ball comes within reach of a point (`broad_phase.balls`)."""
+        (S,) (m) of the cloud: the spheres of a body with fewer than CLOUD_BALL_MIN one by
+        one, a larger body's only where its ball comes within reach of a point
+        (`broad_phase.body_balls`)."""
         near = np.zeros(centres.shape[:2], bool)
         if self.tree is None:
             return near
         bound = float(reach.max())
-        if not bounded:  # every sphere one by one, as they come
-            d, _ = self.tree.query(centres.reshape(-1, 3), k=1, distance_upper_bound=bound)
-            return d.reshape(near.shape) < reach
-        parts = [(np.arange(len(centres)), few)]
-        for ball in bounded:
-            d, _ = self.tree.query(ball.middle, k=1, distance_upper_bound=float(ball.radius.max()))
-            parts.append((np.flatnonzero(d < ball.radius), ball.spheres))
-        for rows, spheres in parts:
-            if len(rows) and len(spheres):
-                at = centres[rows[:, None], spheres[None, :]]
-                d, _ = self.tree.query(at.reshape(-1, 3), k=1, distance_upper_bound=bound)
-                near[rows[:, None], spheres[None, :]] = d.reshape(at.shape[:2]) < reach[spheres]
+        few, big = balls.split(CLOUD_BALL_MIN)
+        d, _ = self.tree.query(centres[:, few], k=1, distance_upper_bound=bound)
+        near[:, few] = d < reach[few]
+        if len(big) and len(centres):
+            radius = balls.radius[:, big]
+            d, _ = self.tree.query(balls.middle[:, big], k=1, distance_upper_bound=radius.max())
+            rows, groups = np.nonzero(d < radius)
+            pair, sphere = balls.members(rows, big[groups])
+            row = rows[pair]
+            d, _ = self.tree.query(centres[row, sphere], k=1, distance_upper_bound=bound)
+            near[row, sphere] = d < reach[sphere]
         return near
-
-    def _hits(
-        self, centres: np.ndarray, radius: np.ndarray, body: np.ndarray, margin: float
-    ) -> np.ndarray:
-        """(B, S) whether each sphere touches an obstacle, a keep-out box or the floor."""
-        floor, boxes, cloud = self._contacts(centres, radius, body, margin)
-        return floor | boxes.any(axis=-1) | cloud
 
     def what_hits(self, q: np.ndarray, *, hand: bool = True) -> list[str]:
         """Names of what configuration q (6,) touches: "floor", a keep-out box, or "cloud"."""
@@ -320,6 +362,6 @@ class CollisionChecker:
         coarse = np.zeros(n, bool)
         coarse[::SEGMENT_COARSE] = coarse[-1] = True
         for part in (Q[coarse], Q[~coarse]):
-            if len(part) and not self.clearance_ok(part, **kw).all():  # type: ignore[arg-type]
+            if len(part) and not self.all_clear(part, **kw):
                 return False
         return True

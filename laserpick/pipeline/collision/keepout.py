@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from laserpick.description.shapes import IDENTITY, KEEPOUT_BOXES
-from laserpick.pipeline.collision.broad_phase import Ball, balls
+from laserpick.pipeline.collision.broad_phase import BodyBalls, body_balls
 
 _LO = np.array([b.lo for b in KEEPOUT_BOXES])
 _HI = np.array([b.hi for b in KEEPOUT_BOXES])
@@ -44,36 +44,30 @@ def box_contacts(
     centres: np.ndarray,
     reach: np.ndarray,
     body: np.ndarray,
-    grouped: tuple[np.ndarray, list[Ball]] | None = None,
+    bounded: BodyBalls | None = None,
 ) -> np.ndarray:
     """(B, S, K) whether each sphere comes within its `reach` (S,) (m: its radius and the
     margin) of each keep-out box that checks its `body` (S,) (`BOX_CHECKS`), at centres
-    (B, S, 3) (m, `base`): the verdicts of comparing `box_gaps` of every centre, the many
-    spheres of one body measured only against the boxes their ball comes near
-    (`broad_phase.balls`, or `grouped`, what it gave for these spheres)."""
-    few, bounded = grouped if grouped is not None else balls(centres, reach, body)
-    if not bounded:  # every sphere one by one, as they come
-        return (box_gaps(centres) < reach[:, None]) & BOX_CHECKS[body]
+    (B, S, 3) (m, `base`): the verdicts of comparing `box_gaps` of every centre, a body's
+    spheres measured only against the boxes its ball comes near (`broad_phase.body_balls`,
+    or `bounded`, what it gave for these spheres)."""
+    balls = bounded if bounded is not None else body_balls(centres, reach, body)
     out = np.zeros((*centres.shape[:2], len(KEEPOUT_BOXES)), bool)
-    if len(few):
-        near = box_gaps(centres[:, few]) < reach[few, None]
-        out[:, few] = near & BOX_CHECKS[body[few]]
-    for ball in bounded:
-        near_ball = (box_gaps(ball.middle) < ball.radius[:, None]) & BOX_CHECKS[ball.body]
-        rows, boxes = np.nonzero(near_ball)
-        if len(rows):
-            mine = ball.spheres
-            near = _gaps_to(centres[rows[:, None], mine[None, :]], boxes) < reach[mine]
-            out[rows[:, None], mine[None, :], boxes[:, None]] = near
+    ball_body = body[balls.order[balls.starts]]
+    near = (box_gaps(balls.middle) < balls.radius[..., None]) & BOX_CHECKS[ball_body][None]
+    rows, groups, boxes = np.nonzero(near)
+    if len(rows):
+        pair, sphere = balls.members(rows, groups)
+        row, box = rows[pair], boxes[pair]
+        out[row, sphere, box] = _gaps_to(centres[row, sphere], box) < reach[sphere]
     return out
 
 
 def _gaps_to(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """Distance (m) from points (M, N, 3) of `base` to keep-out box boxes[m] (M,), 0
-    inside: (M, N), as `box_gaps` measures it."""
+    """Distance (m) from each point (N, 3) of `base` to keep-out box boxes[n] (N,), 0
+    inside: (N,), as `box_gaps` measures it."""
+    local = points.copy()
     turned = _IS_TURNED[boxes]
-    local = points
     if turned.any():
-        local = points.copy()
-        local[turned] = np.einsum("mni,mij->mnj", points[turned], _TURNS[boxes[turned]])
-    return _gaps(local, _LO[boxes][:, None], _HI[boxes][:, None])
+        local[turned] = np.einsum("ni,nij->nj", points[turned], _TURNS[boxes[turned]])
+    return _gaps(local, _LO[boxes], _HI[boxes])
