@@ -35,7 +35,12 @@ from laserpick.behaviours import (
 )
 from laserpick.behaviours.basket_way import path_to_a_drop
 from laserpick.behaviours.carry import holding_poses
-from laserpick.behaviours.drop_postures import clear_carrying, reach_times
+from laserpick.behaviours.drop_postures import (
+    _drop_candidates,
+    clear_carrying,
+    reach_times,
+    warm_drop_postures,
+)
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.laid_in import hand_down_turns
 from laserpick.bench.referee import Referee
@@ -167,6 +172,22 @@ def test_after_a_drop_with_no_way_to_stand_by_or_ready_the_arm_folds_away(robot)
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
     assert b.stand_by().ok
     assert np.abs(robot.joint_state().q - dims.UR5_HOME_Q).max() < 0.05
+
+
+def test_the_drop_postures_are_worked_out_ahead_on_a_thread():
+    """`warm_drop_postures` (what `laserpick serve` starts with) works out both families on
+    a daemon thread; a pick asking for them after it computes nothing."""
+    settings = BEHAVIOUR.model_copy(update={"drop_heights": [0.123]})  # asked nowhere else
+    before = _drop_candidates.cache_info()
+    thread = warm_drop_postures(settings)
+    assert thread.daemon
+    thread.join(timeout=120)
+    assert not thread.is_alive()
+    warmed = _drop_candidates.cache_info()
+    assert warmed.currsize == before.currsize + 2
+    assert len(drop_candidates(heights=[0.123])) > 0
+    assert len(drop_candidates(tilted=True, heights=[0.123])) > 0
+    assert _drop_candidates.cache_info().misses == warmed.misses
 
 
 def test_a_tall_object_held_at_its_top_is_laid_into_the_basket():

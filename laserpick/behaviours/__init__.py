@@ -23,6 +23,7 @@ from laserpick.behaviours.drop_postures import (
     holds_over_basket,
     past_the_opening,
     rank_drop_postures,
+    warm_drop_postures,
 )
 from laserpick.behaviours.guarded_motion import GuardedMotion
 from laserpick.behaviours.hand import wait_for_gripper
@@ -80,6 +81,7 @@ __all__ = [
     "tuck_way",
     "turned_hand_xy",
     "wait_for_gripper",
+    "warm_drop_postures",
     "without_leftovers",
 ]
 

@@ -34,7 +34,7 @@ class Stowing(GuardedMotion):
                 up = cartesian_line(self.current_q(), T, self.settings.motion.cartesian_step)
                 # Only when the whole rise is clear: rising into the scooter's camera heads
                 # would leave the planner no collision-free start.
-                if up is not None and checker.clearance_ok(up).all():
+                if up is not None and checker.all_clear(up):
                     failure = self.run(timed(up, self.settings.motion), "rising")
                     if failure is not None:
                         return Outcome(failure)

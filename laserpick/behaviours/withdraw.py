@@ -84,8 +84,8 @@ class Withdrawing(GuardedMotion):
             path = cartesian_line(q, T, s.cartesian_step)
             if (
                 path is None
-                or not checker.clearance_ok(path, payload=payload, margin=margin).all()
-                or not checker.clearance_ok(path, hand=False, margin=arm_margin).all()
+                or not checker.all_clear(path, payload=payload, margin=margin)
+                or not checker.all_clear(path, hand=False, margin=arm_margin)
             ):
                 continue
             return path

@@ -200,10 +200,12 @@ def cmd_serve(args: argparse.Namespace) -> int:
     if journal is None:
         return EXIT_USAGE
 
+    from laserpick.behaviours import warm_drop_postures
     from laserpick.robot.sim.robot import SimRobot
     from laserpick.server.session import Session
 
     session = Session(SimRobot(scene, realtime=True), journal=journal)
+    warm_drop_postures(session.settings.behaviour)  # while the page loads, not at the first pick
     views = _ViewServer()
     try:
         viser_port = views.start(args, session, loopback)

@@ -83,7 +83,7 @@ def straight_lift(
     straightens and its forearm comes down over the hand, and what it holds."""
     for height in sorted({s.lift, s.lift_low, s.lift_least}, reverse=True):
         lift = cartesian_line(q_from, lifted_pose(T_grasp, height), s.cartesian_step)
-        if lift is None or not surroundings.clearance_ok(lift, hand=False).all():
+        if lift is None or not surroundings.all_clear(lift, hand=False):
             continue
         if payload is None or held_clear_of_arm(lift, payload, surroundings.margin).all():
             return lift
@@ -259,7 +259,7 @@ def plan_pick(
         return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
     q_pre = pre[0]
     approach = cartesian_line(q_pre, T_grasp, s.cartesian_step)
-    if approach is None or not world.clearance_ok(approach, hand=False).all():
+    if approach is None or not world.all_clear(approach, hand=False):
         return Failure("ik_plan", "The straight approach to this grasp is blocked.")
     approach[-1] = q_grasp
     up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
