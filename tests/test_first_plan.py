@@ -11,6 +11,7 @@ from arm_poses import EMPTY, top_grasp
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp
 from laserpick.pipeline import first_plan, joint_search
+from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
@@ -154,3 +155,37 @@ def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_lon
     else:
         assert tried == quick_way and grasp is found.ordered()[quick_way - 1]
         assert searched == [(k, short) for k in range(1, quick_way + 1)]
+
+
+@pytest.mark.parametrize("unseen_first", [False, True])
+def test_together_one_full_search_goes_toward_every_pre_grasp(monkeypatch, unseen_first) -> None:
+    """With `grasps_together`, where the short searches found no way, one full search goes
+    toward the pre-grasps of all six grasps at once, best first, and the grasp whose
+    pre-grasp it reaches (here the third) is taken. A way that passes the seen-space test
+    only where the arm will stand at another pre-grasp is not taken: the one it reached is
+    left out, and the others are searched again."""
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(6)])
+    pres = [ik_tcp(pregrasp_pose(g.pose, 0.10), g.ik)[0] for g in found.ordered()]
+    searched: list[tuple[list[int], int]] = []  # (grasps searched toward, samples)
+
+    def search(a, b, checker, rng, s, **kw):
+        goals = np.atleast_2d(b)
+        rows = [next(k for k, p in enumerate(pres, 1) if np.allclose(g, p)) for g in goals]
+        searched.append((rows, s.rrt_max_samples))
+        if s.rrt_max_samples <= first_plan.QUICK_SAMPLES:
+            return None
+        return np.array([a, goals[min(2, len(goals) - 1)]], float)
+
+    unseen = pres[2].tobytes() if unseen_first else None
+    monkeypatch.setattr(joint_search, "joint_path", search)
+    monkeypatch.setattr(plan_module, "_seen_knowing", lambda w, a, b, leg: b.tobytes() != unseen)
+    s = get_settings().motion.model_copy(update={"grasps_together": True})
+    plan, grasp, _ = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
+    assert not isinstance(plan, Failure), plan
+    full = [rows for rows, n in searched if n > first_plan.QUICK_SAMPLES]
+    if unseen_first:
+        assert full == [list(range(1, 7)), [1, 2, 4, 5, 6]]
+        assert grasp is found.ordered()[3] and np.allclose(plan.transit.q[-1], pres[3])
+    else:
+        assert full == [list(range(1, 7))]
+        assert grasp is found.ordered()[2] and np.allclose(plan.transit.q[-1], pres[2])

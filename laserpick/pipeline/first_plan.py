@@ -20,7 +20,15 @@ from laserpick.description.dims import (
 )
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
-from laserpick.pipeline.plan import NO_WAY, PickPlan, plan_pick
+from laserpick.pipeline.plan import (
+    NO_WAY,
+    PickPlan,
+    PickPrep,
+    plan_pick,
+    prepare_pick,
+    transit_to_any,
+    way_to,
+)
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
@@ -101,12 +109,13 @@ def plan_first(
         if done.grasp is not None:
             return done.plan, done.grasp, _place(grasps, done.grasp)
         searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
-    first = _plan_in_order(found, grasps, q_now, rng, s, via, searches, admit)
+    full = _plan_together if s.grasps_together else _plan_in_order
+    first = full(found, grasps, q_now, rng, s, via, searches, admit)
     last = first
     if first.grasp is None and first.no_way and not searches.spent:
         searches.forget_failed()
         again = (UR5_HIGH_READY_Q, *via[:1])
-        last = _plan_in_order(found, first.no_way, q_now, rng, s, again, searches)
+        last = full(found, first.no_way, q_now, rng, s, again, searches)
     if last.grasp is not None:
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
@@ -176,6 +185,66 @@ def _plan_in_order(
             return done
         if done.plan.message == NO_WAY:
             done.no_way.append(grasp)
+        if searches.spent:
+            msg = f"No collision-free path in {searches.failed} searches; no more were tried"
+            done.plan = Failure("ik_plan", msg)
+            break
+    return done
+
+
+def _plan_together(
+    found: GraspSet,
+    grasps: Sequence[Grasp],
+    q_now: np.ndarray,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    via: Sequence[np.ndarray],
+    searches: Searches,
+    admit: Callable[[Grasp], Failure | None] | None = None,
+) -> _Pass:
+    """`_plan_in_order` with the transits searched together: every grasp's search-free part
+    first (`prepare_pick`), then for each way out, best grasp first, one search toward the
+    pre-grasps of all the grasps that take it (`transit_to_any`): the grasp whose way is
+    found is taken, not the best-ranked whose way a full search of its own might find."""
+    stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
+    out = {
+        "via": via,
+        "unstow": UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
+        "standby": standby,
+        "turn": UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
+    }
+    done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
+    ways: dict[bytes, list[tuple[Grasp, PickPrep]]] = {}
+    for grasp in grasps:
+        done.tried += 1
+        refused = admit(grasp) if admit is not None else None
+        if refused is not None:
+            done.plan, done.refused = refused, not ways
+            continue
+        way, _ = way_to(q_now, grasp.ik, found.world, **out)
+        prep = prepare_pick(
+            grasp.ik,
+            way[-1],
+            found.world,
+            found.surroundings,
+            s,
+            check_hand=found.strategy == "vertical",
+            payload=grasp.in_hand(found.carried),
+        )
+        if isinstance(prep, Failure):
+            done.plan = prep
+            continue
+        key = np.vstack(way_to(q_now, prep.q_pre, found.world, **out)[0]).tobytes()
+        ways.setdefault(key, []).append((grasp, prep))
+    for takers in ways.values():
+        q_pres = np.array([prep.q_pre for _, prep in takers])
+        transit = transit_to_any(q_now, q_pres, found.world, rng, s, searches, **out)
+        if transit is not None:
+            grasp, prep = takers[transit[0]]
+            done.plan, done.grasp = prep.planned(transit[1:], s), grasp
+            return done
+        done.plan, done.refused = Failure("ik_plan", NO_WAY), False
+        done.no_way += [grasp for grasp, _ in takers]
         if searches.spent:
             msg = f"No collision-free path in {searches.failed} searches; no more were tried"
             done.plan = Failure("ik_plan", msg)

@@ -168,12 +168,13 @@ class Searches:
         s: MotionSettings,
         seen: bool = True,
     ) -> np.ndarray | None:
-        """`joint_path` from a to b with the hand checked, searched once per pick; seen: with
-        the hand kept where the cameras saw through (`CollisionChecker.clearance_ok`), or
-        where it stands at either end."""
+        """`joint_path` from a to b (6,), or to the first reached of goals b (k, 6) rad, with
+        the hand checked, searched once per pick; seen: with the hand kept where the cameras
+        saw through (`CollisionChecker.clearance_ok`), or where it stands at either end (at
+        any of the goals)."""
         key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
         if key not in self.legs:
-            known = checker.knowing(a, b) if seen else checker
+            known = checker.knowing(a, *np.atleast_2d(b)) if seen else checker
             self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:
                 self.failed += 1

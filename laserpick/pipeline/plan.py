@@ -33,11 +33,15 @@ __all__ = [
     "HAND_CONTACT_TOLERANCE",
     "NO_WAY",
     "PickPlan",
+    "PickPrep",
     "between_the_fingers",
     "hand_fits",
     "plan_pick",
+    "prepare_pick",
     "straight_lift",
     "transit_path",
+    "transit_to_any",
+    "way_to",
 ]
 
 #: How far (m) the hand's spheres may overlap surrounding points at the grasp: the finger
@@ -131,32 +135,88 @@ def transit_path(
 ) -> tuple[np.ndarray, list[ClearFn]] | None:
     """Joint waypoints (K, 6) rad from q_now to the pre-grasp q_pre, clear of the `world`,
     each leg searched once per pick (`searches`): through the way out of where the arm
-    rests (`_way_to`), or else through the first of `via` that the world shows clear. The
+    rests (`way_to`), or else through the first of `via` that the world shows clear. The
     leg to the pre-grasp keeps the hand to space the cameras saw through; so do the legs
     before it, but for the fixed way out of a rest pose. None when a leg finds no way; else
     the waypoints and, for each segment between them, the check its leg was searched with
     (for the blends of `timed`)."""
-    transit = None
-    checks: list[ClearFn] = []
-    way, fixed = _way_to(q_now, q_pre, world, via, unstow, standby, turn)
-    legs = [*way, q_pre]
-    for k, (a, b) in enumerate(itertools.pairwise(legs)):
+    found = transit_to_any(q_now, q_pre, world, rng, s, searches, via, unstow, standby, turn)
+    return None if found is None else found[1:]
+
+
+def transit_to_any(
+    q_now: np.ndarray,
+    q_pres: np.ndarray,
+    world: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    searches: Searches,
+    via: Sequence[np.ndarray] = (),
+    unstow: np.ndarray | None = None,
+    standby: bool = False,
+    turn: np.ndarray | None = None,
+) -> tuple[int, np.ndarray, list[ClearFn]] | None:
+    """`transit_path` to whichever of the pre-grasps q_pres (k, 6) rad, best first, on one
+    way out (`way_to` of the first), the last leg searched toward them all at once
+    (`joint_search.joint_path`: the straight move to the first that has one, else one
+    search that ends at the one it reaches). The seen-space test of that search counts
+    where the arm will stand at each of them as seen; the leg found is kept only where it
+    passes knowing the one it reached alone, else that one is left out and the others
+    searched again. Returns which pre-grasp (its row), the waypoints and their checks."""
+    goals = np.atleast_2d(np.asarray(q_pres, float))
+    way, fixed = way_to(q_now, goals[0], world, via, unstow, standby, turn)
+    transit, checks = np.atleast_2d(way[0]), []
+    for a, b in itertools.pairwise(way):
         # The way out of the stowed pose, to the unstow pose and on to a ready pose, passes
         # beside the scooter and turns the elbow over above the cameras' view; the way from
         # standing by rises from beside the scooter to the front (and turns the elbow over
         # on to the unstow pose, for a grasp on that branch). Fixed ways of straight moves,
         # not held to seen space. Only the leg to the grasp is: turning the elbow over on
         # it swings the hand through space no camera saw, and finds no way.
-        seen = k == len(legs) - 2 or not fixed
-        leg = searches.path(a, b, world, rng, s, seen=seen)
+        leg = searches.path(a, b, world, rng, s, seen=not fixed)
         if leg is None:
             return None
-        transit = leg if transit is None else np.vstack([transit, leg[1:]])
-        checks += [_leg_check(world, a, b, seen)] * (len(leg) - 1)
-    return None if transit is None else (transit, checks)
+        transit = np.vstack([transit, leg[1:]])
+        checks += [_leg_check(world, a, b, not fixed)] * (len(leg) - 1)
+    last = _last_leg(way[-1], goals, world, rng, s, searches)
+    if last is None:
+        return None
+    row, leg = last
+    checks += [_leg_check(world, way[-1], goals[row], True)] * (len(leg) - 1)
+    return row, np.vstack([transit, leg[1:]]), checks
 
 
-def _way_to(
+def _last_leg(
+    a: np.ndarray,
+    goals: np.ndarray,
+    world: CollisionChecker,
+    rng: np.random.Generator,
+    s: MotionSettings,
+    searches: Searches,
+) -> tuple[int, np.ndarray] | None:
+    """The leg from a to whichever of `goals` (k, 6) rad it reaches, held to seen space
+    (`transit_to_any`): the goal's row and the leg's waypoints, or None."""
+    rows = np.arange(len(goals))
+    while len(rows):
+        leg = searches.path(a, goals[rows] if len(rows) > 1 else goals[rows[0]], world, rng, s)
+        if leg is None:
+            return None
+        k = int(np.flatnonzero((goals[rows] == leg[-1]).all(axis=1))[0])
+        if len(rows) == 1 or _seen_knowing(world, a, goals[rows[k]], leg):
+            return int(rows[k]), leg
+        # It passed only where the arm will stand at another goal.
+        rows = np.delete(rows, k)
+    return None
+
+
+def _seen_knowing(world: CollisionChecker, a: np.ndarray, b: np.ndarray, leg: np.ndarray) -> bool:
+    """Whether every segment of `leg` (K, 6) rad passes the seen-space check of the leg from
+    a to b alone (`Searches.path`)."""
+    known = world.knowing(a, b)
+    return all(known.segment_ok(p, q, hand=True, seen=True) for p, q in itertools.pairwise(leg))
+
+
+def way_to(
     q_now: np.ndarray,
     q_pre: np.ndarray,
     world: CollisionChecker,
@@ -201,6 +261,66 @@ def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool
     return lambda Q: known.clearance_ok(Q, hand=True, seen=seen)
 
 
+@dataclass(frozen=True)
+class PickPrep:
+    """The parts of a pick that need no search (`prepare_pick`): the grasp's posture q_grasp
+    (6,) rad and pre-grasp q_pre (6,) rad, and the joint waypoints (K, 6) rad of the
+    straight approach, the 2 cm re-grip lift and the lift."""
+
+    q_grasp: np.ndarray
+    q_pre: np.ndarray
+    approach: np.ndarray
+    up: np.ndarray
+    lift: np.ndarray
+
+    def planned(self, transit: tuple[np.ndarray, list[ClearFn]], s: MotionSettings) -> PickPlan:
+        """The pick, timed, with the transit's waypoints and the checks of its segments
+        (`transit_path`)."""
+        return PickPlan(
+            transit=timed(transit[0], s, clear=transit[1]),
+            approach=timed(self.approach, s, tcp_speed=s.approach_speed),
+            regrip=timed(self.up, s, tcp_speed=s.approach_speed),
+            lift=timed(self.lift, s, tcp_speed=s.lift_speed),
+            q_grasp=self.q_grasp,
+            q_lifted=self.lift[-1],
+        )
+
+
+def prepare_pick(
+    q_grasp: np.ndarray,
+    q_from: np.ndarray,
+    world: CollisionChecker,
+    surroundings: CollisionChecker,
+    s: MotionSettings,
+    check_hand: bool = True,
+    payload: np.ndarray | None = None,
+) -> PickPrep | Failure:
+    """The search-free part of `plan_pick` for the grasp whose IK solution is q_grasp, its
+    wrists turned the short way from q_from (rad: where the transit's last leg starts,
+    `way_to`): the hand's fit at the grasp, the pre-grasp, the straight approach and the
+    lift, or the failure that says which could not be had."""
+    # The grasp's posture as the leg to it turns the wrists least: IK took the angles nearest
+    # the ready pose, and a grasp on the other elbow branch, reached from the unstow pose,
+    # turned a wrist 6 rad on the way, through space no camera saw (a bottle on a high table:
+    # found on 1 of 4 draws and a 25 s motion, against 4 of 4 and 10-13 s).
+    q_grasp = nearest_turns(q_grasp, q_from)
+    T_grasp = tcp_pose(q_grasp)
+    if check_hand and not hand_fits(q_grasp, T_grasp, surroundings):
+        return Failure("ik_plan", "The hand would hit something beside the object.")
+    pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
+    if len(pre) == 0:
+        return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
+    approach = cartesian_line(pre[0], T_grasp, s.cartesian_step)
+    if approach is None or not world.all_clear(approach, hand=False):
+        return Failure("ik_plan", "The straight approach to this grasp is blocked.")
+    approach[-1] = q_grasp
+    up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
+    lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
+    if up is None or lift is None:
+        return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
+    return PickPrep(q_grasp, pre[0], approach, up, lift)
+
+
 def plan_pick(
     q_now: np.ndarray,
     q_grasp: np.ndarray,
@@ -225,7 +345,7 @@ def plan_pick(
     fixed too, beside the scooter; `unstow` is then its exit, taken only where no ready
     pose is clear (`transit_path`). turn: where the way out ends for a grasp on the other
     elbow branch: from standing by, `UR5_UNSTOW_Q`; from the stowed pose where no ready
-    pose is clear, `UR5_STANDBY_EXIT_Q` (`_way_to`).
+    pose is clear, `UR5_STANDBY_EXIT_Q` (`way_to`).
     via: configurations the transit may pass through next (the ready poses, from a stowed
     arm): the first that is clear of the cloud is used; none if none is.
     check_hand: check the hand at the grasp against the surroundings; grasp detection that
@@ -245,35 +365,11 @@ def plan_pick(
     """
     s = settings or get_settings().motion
     searches = searches or Searches(s.rrt_max_failed)
-    # The grasp's posture as the leg to it turns the wrists least: IK took the angles nearest
-    # the ready pose, and a grasp on the other elbow branch, reached from the unstow pose,
-    # turned a wrist 6 rad on the way, through space no camera saw (a bottle on a high table:
-    # found on 1 of 4 draws and a 25 s motion, against 4 of 4 and 10-13 s).
-    way, _ = _way_to(q_now, q_grasp, world, via, unstow, standby, turn)
-    q_grasp = nearest_turns(q_grasp, way[-1])
-    T_grasp = tcp_pose(q_grasp)
-    if check_hand and not hand_fits(q_grasp, T_grasp, surroundings):
-        return Failure("ik_plan", "The hand would hit something beside the object.")
-    pre = ik_tcp(pregrasp_pose(T_grasp, s.approach_distance), q_grasp)
-    if len(pre) == 0:
-        return Failure("ik_plan", "The arm cannot reach the pose before this grasp.")
-    q_pre = pre[0]
-    approach = cartesian_line(q_pre, T_grasp, s.cartesian_step)
-    if approach is None or not world.all_clear(approach, hand=False):
-        return Failure("ik_plan", "The straight approach to this grasp is blocked.")
-    approach[-1] = q_grasp
-    up = cartesian_line(q_grasp, lifted_pose(T_grasp, s.regrip_lift), s.cartesian_step)
-    lift = None if up is None else straight_lift(up[-1], T_grasp, surroundings, s, payload)
-    if lift is None:
-        return Failure("ik_plan", "The arm cannot lift straight up from this grasp.")
-    transit = transit_path(q_now, q_pre, world, rng, s, searches, via, unstow, standby, turn)
+    way, _ = way_to(q_now, q_grasp, world, via, unstow, standby, turn)
+    prep = prepare_pick(q_grasp, way[-1], world, surroundings, s, check_hand, payload)
+    if isinstance(prep, Failure):
+        return prep
+    transit = transit_path(q_now, prep.q_pre, world, rng, s, searches, via, unstow, standby, turn)
     if transit is None:
         return Failure("ik_plan", NO_WAY)
-    return PickPlan(
-        transit=timed(transit[0], s, clear=transit[1]),
-        approach=timed(approach, s, tcp_speed=s.approach_speed),
-        regrip=timed(up, s, tcp_speed=s.approach_speed),
-        lift=timed(lift, s, tcp_speed=s.lift_speed),
-        q_grasp=q_grasp,
-        q_lifted=lift[-1],
-    )
+    return prep.planned(transit, s)

@@ -139,6 +139,13 @@ class MotionSettings(BaseModel):
         " which alone keeps runs the same: the slowest recorded search that used all its"
         " samples took 30 s on a loaded 2-core machine.",
     )
+    grasps_together: bool = Field(
+        False,
+        description="Where the short searches planned no grasp, search the transit toward"
+        " every grasp's pre-grasp at once (one search for each way out), and take the grasp"
+        " it reaches, rather than a full search for each grasp, best first. Ours: off until"
+        " the kitchen protocols are rerun on it (docs/pipeline.md).",
+    )
     rrt_max_failed: int = Field(
         6,
         ge=1,
