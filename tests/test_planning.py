@@ -22,7 +22,8 @@ from laserpick.pipeline.collision import (
 )
 from laserpick.pipeline.joint_search import Searches, joint_path
 from laserpick.pipeline.lines import TURN_STEP, cartesian_line
-from laserpick.pipeline.plan import plan_pick, straight_lift, transit_path
+from laserpick.pipeline.pick_prep import straight_lift
+from laserpick.pipeline.plan import plan_pick, transit_path
 from laserpick.pipeline.plan_record import load_search
 from laserpick.pipeline.reach import pregrasp_pose, reachable
 from laserpick.pipeline.rrt import shortcut

@@ -20,15 +20,8 @@ from laserpick.description.dims import (
 )
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
-from laserpick.pipeline.plan import (
-    NO_WAY,
-    PickPlan,
-    PickPrep,
-    plan_pick,
-    prepare_pick,
-    transit_to_any,
-    way_to,
-)
+from laserpick.pipeline.pick_prep import PickPrep, prepare_pick
+from laserpick.pipeline.plan import NO_WAY, PickPlan, plan_pick, transit_to_any, way_to
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
