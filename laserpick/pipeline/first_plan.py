@@ -135,6 +135,20 @@ class _Pass:
     no_way: list[Grasp] = field(default_factory=list)
 
 
+def _way_out(q_now: np.ndarray, via: Sequence[np.ndarray]) -> dict:
+    """The way out of where the arm rests at q_now (rad), as `plan.way_to` takes it: from the
+    stowed pose through the unstow pose, from standing by through its exit where no ready
+    pose is clear, each turning the elbow over where the grasp is on the other branch;
+    elsewhere, through the first clear pose of `via`."""
+    stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
+    return {
+        "via": via,
+        "unstow": UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
+        "standby": standby,
+        "turn": UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
+    }
+
+
 def _plan_in_order(
     found: GraspSet,
     grasps: Sequence[Grasp],
@@ -147,7 +161,7 @@ def _plan_in_order(
 ) -> _Pass:
     """`plan_pick` for each of `grasps` in turn, through the first clear pose of `via`,
     until one plans or the `searches` are spent."""
-    stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
+    out = _way_out(q_now, via)
     done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
     for grasp in grasps:
         done.tried += 1
@@ -165,13 +179,10 @@ def _plan_in_order(
             found.surroundings,
             rng,
             s,
-            via=via,
             check_hand=found.strategy == "vertical",
             searches=searches,
-            unstow=UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
-            standby=standby,
-            turn=UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
             payload=grasp.in_hand(found.carried),
+            **out,
         )
         if not isinstance(done.plan, Failure):
             done.grasp = grasp
@@ -199,13 +210,7 @@ def _plan_together(
     first (`prepare_pick`), then for each way out, best grasp first, one search toward the
     pre-grasps of all the grasps that take it (`transit_to_any`): the grasp whose way is
     found is taken, not the best-ranked whose way a full search of its own might find."""
-    stowed, standby = at_pose(q_now, UR5_HOME_Q), at_pose(q_now, UR5_STANDBY_Q)
-    out = {
-        "via": via,
-        "unstow": UR5_UNSTOW_Q if stowed else UR5_STANDBY_EXIT_Q if standby else None,
-        "standby": standby,
-        "turn": UR5_UNSTOW_Q if standby else UR5_STANDBY_EXIT_Q if stowed else None,
-    }
+    out = _way_out(q_now, via)
     done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
     ways: dict[bytes, list[tuple[Grasp, PickPrep]]] = {}
     for grasp in grasps:
