@@ -106,6 +106,7 @@ class CollisionChecker:
         payload: np.ndarray | None = None,
         margin: float | None = None,
         seen: bool = False,
+        stop: bool = False,
     ) -> np.ndarray:
         """(B,) True where configuration Q[b] (B, 6) (rad) collides with nothing.
 
@@ -116,29 +117,10 @@ class CollisionChecker:
         cameras saw through (`unseen`): a planned transit may not take space no camera saw
         for free. The hand is what swings out into the room, into furniture beyond the
         cameras' view (a bookshelf's board); the shoulder and upper arm stay below and beside
-        the sensor posts, where no camera looks, so they are not held to it.
+        the sensor posts, where no camera looks, so they are not held to it. stop: return once
+        a test finds a configuration blocked; the configurations not asked about yet read
+        clear, so only `.all()` of what returns is then the verdict (`all_clear`).
         """
-        return self._ok(Q, hand, payload, margin, seen, stop=False)
-
-    def all_clear(self, Q: np.ndarray, **kw) -> bool:
-        """Whether every configuration of Q (B, 6) (rad) collides with nothing
-        (`clearance_ok`'s options `kw`), the check stopping at the first test that finds one
-        that does: three of four segments a search tries are blocked, most at their first
-        configurations, and there every further test was work for nothing."""
-        return bool(self._ok(Q, stop=True, **kw).all())
-
-    def _ok(
-        self,
-        Q: np.ndarray,
-        hand: bool = True,
-        payload: np.ndarray | None = None,
-        margin: float | None = None,
-        seen: bool = False,
-        *,
-        stop: bool,
-    ) -> np.ndarray:
-        """`clearance_ok`; with `stop`, only `.all()` of what it returns is the verdict
-        (`_clear`)."""
         margin = self.margin if margin is None else margin
         Q = np.atleast_2d(np.asarray(Q, float))
         frames = body_frames(Q)
@@ -153,6 +135,13 @@ class CollisionChecker:
         if len(rows) and not (stop and len(rows) < len(Q)):
             clear[rows] = self._clear(frames[rows], hand, payload, margin, seen, stop)
         return clear
+
+    def all_clear(self, Q: np.ndarray, **kw) -> bool:
+        """Whether every configuration of Q (B, 6) (rad) collides with nothing
+        (`clearance_ok`'s options `kw`), the check stopping at the first test that finds one
+        that does: three of four segments a search tries are blocked, most at their first
+        configurations, and there every further test was work for nothing."""
+        return bool(self.clearance_ok(Q, stop=True, **kw).all())
 
     def _coarse_of(self, payload: np.ndarray) -> np.ndarray:
         """`coarse_payload` of `payload`, kept for the next call: a search asks about the
