@@ -76,6 +76,8 @@ def plan_first(
     `rrt_max_failed` of them found no way; then, where none planned, with full searches, best
     first again, the ways the short ones found kept: a grasp whose way is found at once is
     taken before a better-ranked one whose way needs seconds of search, or none is there.
+    With `grasps_together`, the full searches are one for each way out, toward the
+    pre-grasps of all the grasps that take it (`_plan_together`).
     From anywhere but the ready pose (stowed or standing by, mostly) the transit goes
     through a ready pose; from the stowed pose, through the unstow pose first; from standing
     by, through its exit where no ready pose is clear. From either, the way to the ready
@@ -215,6 +217,8 @@ def _plan_together(
     ways: dict[bytes, list[tuple[Grasp, PickPrep]]] = {}
     for grasp in grasps:
         done.tried += 1
+        if grasp.ik is None:
+            raise ValueError("plan_first needs grasps from the reachability filter")
         refused = admit(grasp) if admit is not None else None
         if refused is not None:
             done.plan, done.refused = refused, not ways
