@@ -68,6 +68,7 @@ def _runs(body_key: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @functools.lru_cache(maxsize=32)
 def _split(order_key: bytes, counts_key: bytes, least: int) -> tuple[np.ndarray, np.ndarray]:
+    """`BodyBalls.split` for its `order` and `counts` (int64 bytes), kept as `_runs` is."""
     order, counts = np.frombuffer(order_key, np.int64), np.frombuffer(counts_key, np.int64)
     big = counts >= least
     return np.sort(order[~np.repeat(big, counts)]), np.flatnonzero(big)
