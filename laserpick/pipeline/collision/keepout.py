@@ -66,8 +66,9 @@ def box_contacts(
 def _gaps_to(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """Distance (m) from each point (N, 3) of `base` to keep-out box boxes[n] (N,), 0
     inside: (N,), as `box_gaps` measures it."""
-    local = points.copy()
     turned = _IS_TURNED[boxes]
+    local = points
     if turned.any():
+        local = points.copy()
         local[turned] = np.einsum("ni,nij->nj", points[turned], _TURNS[boxes[turned]])
     return _gaps(local, _LO[boxes], _HI[boxes])
