@@ -159,7 +159,8 @@ def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_lon
 
 @pytest.mark.parametrize("unseen_first", [False, True])
 def test_together_one_full_search_goes_toward_every_pre_grasp(monkeypatch, unseen_first) -> None:
-    """With `grasps_together`, where the short searches found no way, one full search goes
+    """With `grasps_together`, the short searches go toward the first grasp alone, then
+    toward the five after it at once; where they found no way, one full search goes
     toward the pre-grasps of all six grasps at once, best first, and the grasp whose
     pre-grasp it reaches (here the third) is taken. A way that passes the seen-space test
     only where the arm will stand at another pre-grasp is not taken: the one it reached is
@@ -183,6 +184,10 @@ def test_together_one_full_search_goes_toward_every_pre_grasp(monkeypatch, unsee
     plan, grasp, _ = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
     assert not isinstance(plan, Failure), plan
     full = [rows for rows, n in searched if n > first_plan.QUICK_SAMPLES]
+    assert [rows for rows, n in searched if n <= first_plan.QUICK_SAMPLES] == [
+        [1],
+        list(range(2, 7)),
+    ]
     if unseen_first:
         assert full == [list(range(1, 7)), [1, 2, 4, 5, 6]]
         assert grasp is found.ordered()[3] and np.allclose(plan.transit.q[-1], pres[3])
