@@ -128,9 +128,10 @@ def _grasps_pick(*where: tuple[float, float, float]) -> GraspSet:
 def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_long_search(
     monkeypatch, quick_way
 ) -> None:
-    """Eight grasps, whose ways from ready to their pre-grasps only full searches find, but
-    for the one at `quick_way` (its place in the order), which a short search finds: that
-    one is taken, after the short searches of the grasps before it. Where no short search
+    """Grasp by grasp (`grasps_together` off): eight grasps, whose ways from ready to their
+    pre-grasps only full searches find, but for the one at `quick_way` (its place in the
+    order), which a short search finds: that one is taken, after the short searches of the
+    grasps before it. Where no short search
     finds a way, as many as the full searches may fail (`rrt_max_failed`) are spent, and
     the full searches take the best grasp."""
     searched: list[tuple[int, int]] = []  # (grasp, samples)
@@ -144,7 +145,7 @@ def test_a_grasp_whose_way_is_found_at_once_is_taken_before_one_that_needs_a_lon
         return np.array([a, b], float) if not quick or k == quick_way else None
 
     monkeypatch.setattr(joint_search, "joint_path", search)
-    s = get_settings().motion
+    s = get_settings().motion.model_copy(update={"grasps_together": False})
     plan, grasp, tried = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
     assert not isinstance(plan, Failure), plan
     short, full = first_plan.QUICK_SAMPLES, s.rrt_max_samples
@@ -180,7 +181,8 @@ def test_together_one_full_search_goes_toward_every_pre_grasp(monkeypatch, unsee
     unseen = pres[2].tobytes() if unseen_first else None
     monkeypatch.setattr(joint_search, "joint_path", search)
     monkeypatch.setattr(plan_module, "_seen_knowing", lambda w, a, b, leg: b.tobytes() != unseen)
-    s = get_settings().motion.model_copy(update={"grasps_together": True})
+    s = get_settings().motion
+    assert s.grasps_together
     plan, grasp, _ = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
     assert not isinstance(plan, Failure), plan
     full = [rows for rows, n in searched if n > first_plan.QUICK_SAMPLES]

@@ -140,12 +140,13 @@ class MotionSettings(BaseModel):
         " samples took 30 s on a loaded 2-core machine.",
     )
     grasps_together: bool = Field(
-        False,
-        description="Where the short searches planned no grasp, search the transit toward"
-        " every grasp's pre-grasp at once (one search for each way out), and take the grasp"
-        " it reaches, rather than a full search for each grasp, best first. Ours: off until"
-        " the headline protocols and the pick-place sweep have run on it; on 18 fresh"
-        " in-situ seeds it did one task more and planned quicker (docs/pipeline.md).",
+        True,
+        description="Once the first grasp's short search found no way, search the transit"
+        " toward every other grasp's pre-grasp at once (one search for each way out, short"
+        " then full), and take the grasp it reaches, rather than a search for each grasp,"
+        " best first. Ours: grasp by grasp, a pick whose best grasps have no way spends a"
+        " search on each before one that has; on fresh in-situ seeds it planned quicker and"
+        " did as many tasks or more (docs/pipeline.md).",
     )
     rrt_max_failed: int = Field(
         6,
