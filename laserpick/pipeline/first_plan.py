@@ -5,9 +5,8 @@ radians.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -22,7 +21,7 @@ from laserpick.description.dims import (
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
 from laserpick.pipeline.pick_prep import PickPrep, prepare_pick
-from laserpick.pipeline.plan import NO_WAY, PickPlan, plan_pick, transit_to_any, way_to
+from laserpick.pipeline.plan import NO_WAY, PickPlan, transit_path, transit_to_any, way_to
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
@@ -99,23 +98,22 @@ def plan_first(
     s = settings or get_settings().motion
     grasps = list(found.ordered() if order is None else order)
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
+    pick = _Pick(found, q_now, rng, admit)
     searches = Searches(s.rrt_max_failed)
-    preps: dict[tuple[int, bytes], PickPrep | Failure] = {}
     if s.rrt_max_samples > QUICK_SAMPLES:
         quick = Searches(s.rrt_max_failed)
         short = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})
-        done = _quick_pass(found, grasps, q_now, rng, short, via, quick, admit, preps)
+        done = _quick_pass(pick, grasps, short, via, quick)
         if done.grasp is not None:
             return done.plan, done.grasp, _place(grasps, done.grasp)
         searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
-    together = functools.partial(_plan_together, preps=preps)
-    full = together if s.grasps_together else _plan_in_order
-    first = full(found, grasps, q_now, rng, s, via, searches, admit)
+    full = _plan_together if s.grasps_together else _plan_in_order
+    first = full(pick, grasps, s, via, searches)
     last = first
     if first.grasp is None and first.no_way and not searches.spent:
         searches.forget_failed()
         again = (UR5_HIGH_READY_Q, *via[:1])
-        last = full(found, first.no_way, q_now, rng, s, again, searches)
+        last = full(replace(pick, admit=None), first.no_way, s, again, searches)
     if last.grasp is not None:
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
@@ -142,6 +140,43 @@ class _Pass:
     no_way: list[Grasp] = field(default_factory=list)
 
 
+@dataclass
+class _Pick:
+    """What the passes of one pick's planning share: the grasps and their clouds (`found`),
+    where the arm is (q_now, rad), the draws, `admit` (None: every grasp is admitted), and
+    the grasps' search-free parts once made (`preps`, by grasp and where the transit's last
+    leg starts)."""
+
+    found: GraspSet
+    q_now: np.ndarray
+    rng: np.random.Generator
+    admit: Callable[[Grasp], Failure | None] | None
+    preps: dict[tuple[int, bytes], PickPrep | Failure] = field(default_factory=dict)
+
+    def refusal(self, grasp: Grasp) -> Failure | None:
+        """`admit`'s refusal of `grasp`, if any; an error for a grasp without IK."""
+        if grasp.ik is None:
+            raise ValueError("plan_first needs grasps from the reachability filter")
+        return self.admit(grasp) if self.admit is not None else None
+
+    def prepared(self, grasp: Grasp, out: dict, s: MotionSettings) -> PickPrep | Failure:
+        """The search-free part of the pick at `grasp` (`prepare_pick`), its transit taking
+        the way `out` (`_way_out`), made once a pick."""
+        q_from = way_to(self.q_now, grasp.ik, self.found.world, **out)[0][-1]
+        made = (id(grasp), q_from.tobytes())
+        if made not in self.preps:
+            self.preps[made] = prepare_pick(
+                grasp.ik,
+                q_from,
+                self.found.world,
+                self.found.surroundings,
+                s,
+                check_hand=self.found.strategy == "vertical",
+                payload=grasp.in_hand(self.found.carried),
+            )
+        return self.preps[made]
+
+
 def _way_out(q_now: np.ndarray, via: Sequence[np.ndarray]) -> dict:
     """The way out of where the arm rests at q_now (rad), as `plan.way_to` takes it: from the
     stowed pose through the unstow pose, from standing by through its exit where no ready
@@ -156,16 +191,18 @@ def _way_out(q_now: np.ndarray, via: Sequence[np.ndarray]) -> dict:
     }
 
 
+def _spent(searches: Searches) -> Failure:
+    """The failure said when the pick's failed searches reached their budget."""
+    msg = f"No collision-free path in {searches.failed} searches; no more were tried"
+    return Failure("ik_plan", msg)
+
+
 def _quick_pass(
-    found: GraspSet,
+    pick: _Pick,
     grasps: Sequence[Grasp],
-    q_now: np.ndarray,
-    rng: np.random.Generator,
     s: MotionSettings,
     via: Sequence[np.ndarray],
     searches: Searches,
-    admit: Callable[[Grasp], Failure | None] | None,
-    preps: dict[tuple[int, bytes], PickPrep | Failure],
 ) -> _Pass:
     """The short searches' pass (`s` holds their samples): grasp by grasp until one plans or
     the `searches` are spent; with `grasps_together`, grasp by grasp until the first whose
@@ -175,114 +212,80 @@ def _quick_pass(
     first grasp alone stays first: an ordinary pick plans it in 0.2 s and need not
     prepare twenty."""
     if not s.grasps_together:
-        return _plan_in_order(found, grasps, q_now, rng, s, via, searches, admit)
-    first = _plan_in_order(found, grasps, q_now, rng, s, via, searches, admit, until_no_way=True)
+        return _plan_in_order(pick, grasps, s, via, searches)
+    first = _plan_in_order(pick, grasps, s, via, searches, until_no_way=True)
     rest = grasps[first.tried :]
     if first.grasp is not None or not first.no_way or not rest or searches.spent:
         return first
-    return _plan_together(found, rest, q_now, rng, s, via, searches, admit, preps)
+    return _plan_together(pick, rest, s, via, searches)
 
 
 def _plan_in_order(
-    found: GraspSet,
+    pick: _Pick,
     grasps: Sequence[Grasp],
-    q_now: np.ndarray,
-    rng: np.random.Generator,
     s: MotionSettings,
     via: Sequence[np.ndarray],
     searches: Searches,
-    admit: Callable[[Grasp], Failure | None] | None = None,
     until_no_way: bool = False,
 ) -> _Pass:
-    """`plan_pick` for each of `grasps` in turn, through the first clear pose of `via`,
-    until one plans or the `searches` are spent (or, `until_no_way`, until the first whose
-    transit found no way)."""
-    out = _way_out(q_now, via)
+    """The pick at each of `grasps` in turn, through the first clear pose of `via`, until one
+    plans or the `searches` are spent (or, `until_no_way`, until the first whose transit
+    found no way)."""
+    out = _way_out(pick.q_now, via)
     done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
     for grasp in grasps:
         done.tried += 1
-        if grasp.ik is None:
-            raise ValueError("plan_first needs grasps from the reachability filter")
-        refused = admit(grasp) if admit is not None else None
+        refused = pick.refusal(grasp)
         done.refused = refused is not None
-        if refused is not None:
-            done.plan = refused
+        prep = refused if refused is not None else pick.prepared(grasp, out, s)
+        if isinstance(prep, Failure):
+            done.plan = prep
             continue
-        done.plan = plan_pick(
-            q_now,
-            grasp.ik,
-            found.world,
-            found.surroundings,
-            rng,
-            s,
-            check_hand=found.strategy == "vertical",
-            searches=searches,
-            payload=grasp.in_hand(found.carried),
-            **out,
+        transit = transit_path(
+            pick.q_now, prep.q_pre, pick.found.world, pick.rng, s, searches, **out
         )
-        if not isinstance(done.plan, Failure):
-            done.grasp = grasp
+        if transit is not None:
+            done.plan, done.grasp = prep.planned(transit, s), grasp
             return done
-        if done.plan.message == NO_WAY:
-            done.no_way.append(grasp)
-            if until_no_way:
-                break
+        done.plan = Failure("ik_plan", NO_WAY)
+        done.no_way.append(grasp)
+        if until_no_way:
+            break
         if searches.spent:
-            msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            done.plan = Failure("ik_plan", msg)
+            done.plan = _spent(searches)
             break
     return done
 
 
 def _plan_together(
-    found: GraspSet,
+    pick: _Pick,
     grasps: Sequence[Grasp],
-    q_now: np.ndarray,
-    rng: np.random.Generator,
     s: MotionSettings,
     via: Sequence[np.ndarray],
     searches: Searches,
-    admit: Callable[[Grasp], Failure | None] | None = None,
-    preps: dict[tuple[int, bytes], PickPrep | Failure] | None = None,
 ) -> _Pass:
     """`_plan_in_order` with the transits searched together: every grasp's search-free part
-    first (`prepare_pick`, kept in `preps` for the pick's later passes), then for each way
-    out, best grasp first, one search toward the pre-grasps of all the grasps that take it
-    (`transit_to_any`): the grasp whose way is found is taken, not the best-ranked whose
-    way a full search of its own might find."""
-    preps = {} if preps is None else preps
-    out = _way_out(q_now, via)
+    first, then for each way out, best grasp first, one search toward the pre-grasps of all
+    the grasps that take it (`transit_to_any`): the grasp whose way is found is taken, not
+    the best-ranked whose way a full search of its own might find."""
+    out = _way_out(pick.q_now, via)
     done = _Pass(Failure("ik_plan", "There is no grasp to plan for."))
     ways: dict[bytes, list[tuple[Grasp, PickPrep]]] = {}
     for grasp in grasps:
         done.tried += 1
-        if grasp.ik is None:
-            raise ValueError("plan_first needs grasps from the reachability filter")
-        refused = admit(grasp) if admit is not None else None
+        refused = pick.refusal(grasp)
         if refused is not None:
             done.plan, done.refused = refused, not ways
             continue
-        q_from = way_to(q_now, grasp.ik, found.world, **out)[0][-1]
-        made = (id(grasp), q_from.tobytes())
-        if made not in preps:
-            preps[made] = prepare_pick(
-                grasp.ik,
-                q_from,
-                found.world,
-                found.surroundings,
-                s,
-                check_hand=found.strategy == "vertical",
-                payload=grasp.in_hand(found.carried),
-            )
-        prep = preps[made]
+        prep = pick.prepared(grasp, out, s)
         if isinstance(prep, Failure):
             done.plan = prep
             continue
-        key = np.vstack(way_to(q_now, prep.q_pre, found.world, **out)[0]).tobytes()
+        key = np.vstack(way_to(pick.q_now, prep.q_pre, pick.found.world, **out)[0]).tobytes()
         ways.setdefault(key, []).append((grasp, prep))
     for takers in ways.values():
         q_pres = np.array([prep.q_pre for _, prep in takers])
-        transit = transit_to_any(q_now, q_pres, found.world, rng, s, searches, **out)
+        transit = transit_to_any(pick.q_now, q_pres, pick.found.world, pick.rng, s, searches, **out)
         if transit is not None:
             grasp, prep = takers[transit[0]]
             done.plan, done.grasp = prep.planned(transit[1:], s), grasp
@@ -290,7 +293,6 @@ def _plan_together(
         done.plan, done.refused = Failure("ik_plan", NO_WAY), False
         done.no_way += [grasp for grasp, _ in takers]
         if searches.spent:
-            msg = f"No collision-free path in {searches.failed} searches; no more were tried"
-            done.plan = Failure("ik_plan", msg)
+            done.plan = _spent(searches)
             break
     return done
