@@ -4,8 +4,9 @@ robot's description; it imports neither the simulator nor the robot.
 
 The flow of a pick: `perceive` (fuse the depth frames, find the laser mark, segment the
 target) -> `find_grasps` (candidates by strategy, among them GPD's `detect_grasps`; the
-reachability filter; 004's score and clusters) -> `plan_first` (`plan_pick` for each grasp
-in order until one plans, checked with a `CollisionChecker`). A place asks `place_target`
+reachability filter; 004's score and clusters) -> `plan_first` (the best grasp's pick
+planned alone, then the transit searched toward all the others at once, until one plans;
+`plan_pick` plans one grasp's; checked with a `CollisionChecker`). A place asks `place_target`
 for where to set the object down. Frames: `base` (x forward, y left, z up), metres, radians.
 """
 

@@ -141,10 +141,10 @@ def prepare_pick(
     check_hand: bool = True,
     payload: np.ndarray | None = None,
 ) -> PickPrep | Failure:
-    """The search-free part of `plan_pick` for the grasp whose IK solution is q_grasp, its
-    wrists turned the short way from q_from (rad: where the transit's last leg starts,
-    `way_to`): the hand's fit at the grasp, the pre-grasp, the straight approach and the
-    lift, or the failure that says which could not be had."""
+    """The search-free part of a pick (`plan.plan_pick`) for the grasp whose IK solution is
+    q_grasp, its wrists turned the short way from q_from (rad: where the transit's last leg
+    starts, `way_to`): the hand's fit at the grasp, the pre-grasp, the straight approach and
+    the lift, or the failure that says which could not be had."""
     # The grasp's posture as the leg to it turns the wrists least: IK took the angles nearest
     # the ready pose, and a grasp on the other elbow branch, reached from the unstow pose,
     # turned a wrist 6 rad on the way, through space no camera saw (a bottle on a high table:
