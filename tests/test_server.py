@@ -331,13 +331,14 @@ def test_dropping_the_controller_websocket_halts_motion(server: ServeProcess) ->
         time.sleep(1.5)
     finally:
         watcher.close()
-    after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
-    assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
-    moving = [dt for dt, qd in after if qd > 0.01]
-    assert not moving or max(moving) < 0.5, f"the arm kept moving {max(moving):.2f} s after"
-    state = c.settled()
-    c.close()
-    assert "went silent" in state["failure"]["message"]
+    try:  # the lease given back even where an assertion fails, so the next test may take it
+        after = [(wall - dropped, qd) for wall, _, qd in watcher.frames if wall > dropped]
+        assert after and after[-1][0] > 1.0, "the stream did not go on after the drop"
+        moving = [dt for dt, qd in after if qd > 0.01]
+        assert not moving or max(moving) < 0.5, f"the arm kept moving {max(moving):.2f} s after"
+        assert "went silent" in c.settled()["failure"]["message"]
+    finally:
+        c.close()
 
 
 @pytest.mark.parametrize("via", ["rest", "websocket"])
@@ -357,15 +358,17 @@ def test_a_silent_controllers_pick_halts_within_the_watchdog(
         time.sleep(bound + 2.0)
     finally:
         watcher.close()
-    frames = [(t - last, qd) for t, qd in watcher.stamped if t > last]
-    assert any(qd > 0.01 for dt, qd in frames if dt < 0.4), "not moving when it went silent"
-    late = [qd for dt, qd in frames if dt >= bound]
-    assert len(late) > 10, "the stream did not go on after the silence"
-    assert max(late) < 0.01, f"joints at {max(late):.3f} rad/s {bound:.3f} s after silence"
-    state = c.settled()
-    assert "went silent" in state["failure"]["message"]
-    rows = c.http.get(f"{server.url}{API}/journal", params={"format": "json"}).json()
-    c.close()
+    try:  # the lease given back even where an assertion fails, so the next test may take it
+        frames = [(t - last, qd) for t, qd in watcher.stamped if t > last]
+        assert any(qd > 0.01 for dt, qd in frames if dt < 0.4), "not moving when it went silent"
+        late = [qd for dt, qd in frames if dt >= bound]
+        assert len(late) > 10, "the stream did not go on after the silence"
+        assert max(late) < 0.01, f"joints at {max(late):.3f} rad/s {bound:.3f} s after silence"
+        state = c.settled()
+        assert "went silent" in state["failure"]["message"]
+        rows = c.http.get(f"{server.url}{API}/journal", params={"format": "json"}).json()
+    finally:
+        c.close()
     halted = [r for r in rows if r["action"] == "watchdog" and r["outcome"] == "halted"]
     assert halted and "went silent" in halted[-1]["message"]
 
