@@ -142,11 +142,12 @@ class MotionSettings(BaseModel):
     grasps_together: bool = Field(
         True,
         description="Once the first grasp's short search found no way, search the transit"
-        " toward every other grasp's pre-grasp at once (one search for each way out, short"
-        " then full), and take the grasp it reaches, rather than a search for each grasp,"
-        " best first. Ours: grasp by grasp, a pick whose best grasps have no way spends a"
-        " search on each before one that has; on fresh in-situ seeds it planned quicker and"
-        " did as many tasks or more (docs/pipeline.md).",
+        " toward the other grasps' pre-grasps at once (short, one search for each way out),"
+        " then toward all of them (full), and take the grasp it reaches, rather than a"
+        " search for each grasp, best first. Ours: grasp by grasp, a pick whose best grasps"
+        " have no way spends a search on each before one that has; on 17 fresh in-situ seeds"
+        " the pick planned in 0.70 s a try against 1.19 s, one task of 156 fewer done"
+        " (docs/pipeline.md).",
     )
     rrt_max_failed: int = Field(
         6,
