@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from laserpick.behaviours import warm_drop_postures
 from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
 from laserpick.pipeline.first_plan import at_rest
@@ -77,10 +78,13 @@ def trial_settings(seed: int) -> Settings:
 
 
 def open_session(scene: Scene, seed: int, settle: float = 0.5) -> Session:
-    """A session on a headless (deterministic, faster than real time) robot in `scene`."""
+    """A session on a headless (deterministic, faster than real time) robot in `scene`, its
+    drop postures worked out before the trial as `laserpick serve` does as it starts
+    (`warm_drop_postures`): not charged to the first pick for the basket's planning."""
     settings = trial_settings(seed)
     robot = SimRobot(scene, realtime=False, settings=settings)
     robot.sim.settle(settle)
+    warm_drop_postures(settings.behaviour).join()
     return Session(robot, settings=settings)
 
 
