@@ -33,7 +33,7 @@ from laserpick.behaviours import (
     holds_over_basket,
     rank_drop_postures,
 )
-from laserpick.behaviours.basket_way import path_to_a_drop
+from laserpick.behaviours.basket_way import BasketWay, path_to_a_drop
 from laserpick.behaviours.carry import holding_poses
 from laserpick.behaviours.drop_postures import (
     _drop_candidates,
@@ -43,6 +43,7 @@ from laserpick.behaviours.drop_postures import (
 )
 from laserpick.behaviours.held import Held
 from laserpick.behaviours.laid_in import hand_down_turns
+from laserpick.behaviours.messages import TUCKING_FIRST
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import nearest_turns, tcp_pose
@@ -499,3 +500,52 @@ def test_on_from_the_tucked_pose_the_drops_wrists_turn_the_short_way(monkeypatch
     np.testing.assert_allclose(tcp_pose(path[-1]), tcp_pose(drop), atol=1e-9)
     assert np.all(np.abs(path[-1][4:] - tucked[4:]) <= np.pi)
     np.testing.assert_allclose(path[-1], nearest_turns(drop, tucked))
+
+
+def test_where_only_the_way_to_the_tucked_pose_is_found_the_basket_way_keeps_it(monkeypatch):
+    """Out of a shelf's gap, the search reaches the tucked pose but not on from it to the
+    basket: the carry's way keeps the way found to the tucked pose, for the arm to take
+    instead of searching it again before it searches on."""
+    q_from, held, tucked = _held_in_a_gap(monkeypatch)
+
+    def only_to_the_tuck(a, b, *args, **kw):
+        to_tuck = np.allclose(np.atleast_2d(b)[0], tucked)
+        return np.array([a, tucked]) if to_tuck else None
+
+    monkeypatch.setattr(joint_search, "joint_path", only_to_the_tuck)
+    way = basket_way(q_from, held, SETTINGS, np.random.default_rng(0))
+    assert way is not None and way.drops and way.path is None
+    assert way.tucking is not None
+    np.testing.assert_allclose(way.tucking[0], q_from)
+    np.testing.assert_allclose(way.tucking[-1], tucked)
+
+
+def test_a_carry_whose_way_ends_tucked_takes_it_then_searches_on_to_the_basket(robot):
+    """Given a carry found only as far as the tucked pose (`BasketWay.tucking`), the drop
+    takes that way first, says so, and searches on from the tucked pose to the basket,
+    where the object lands."""
+    b, referee = pick_object(robot, "mug_1")
+    held = b.held
+    assert held is not None
+    tucked, _ = holding_poses(held, SETTINGS)
+    to_tuck = joint_search.joint_path(
+        robot.joint_state().q,
+        tucked,
+        held.surroundings,
+        np.random.default_rng(0),
+        SETTINGS.motion,
+        payload=held.points_tcp,
+    )
+    assert to_tuck is not None
+    way = BasketWay([np.array(q) for q in drop_candidates()[:3]], None, to_tuck)
+    b.searched_ahead = lambda search, held: (way, 0.0)
+    said, followed = [], []
+    b.progress = said.append
+    follow = b.follow
+    b.follow = lambda path, *args, **kw: followed.append(path) or follow(path, *args, **kw)
+    dropped = b.drop_in_basket()
+    assert dropped.ok, dropped.failure
+    assert followed[0] is to_tuck and TUCKING_FIRST in said
+    np.testing.assert_allclose(followed[1][0], tucked, atol=0.05)
+    robot.sleep(1.0)
+    assert referee.in_basket("mug_1")

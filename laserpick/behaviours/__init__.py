@@ -34,6 +34,7 @@ from laserpick.behaviours.messages import (
     NO_BASKET_HOLD,
     NOT_HOLDING,
     PAST_THE_OPENING,
+    TUCKING_FIRST,
     crowded_message,
 )
 from laserpick.behaviours.outcome import CARRY_PLANNING, Outcome
@@ -50,6 +51,7 @@ __all__ = [
     "NOT_HOLDING",
     "NO_BASKET_HOLD",
     "PAST_THE_OPENING",
+    "TUCKING_FIRST",
     "Ahead",
     "Approaching",
     "BasketDrop",

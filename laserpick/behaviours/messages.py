@@ -5,7 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MARK_MOVES", "NOT_HOLDING", "NO_BASKET_HOLD", "PAST_THE_OPENING", "crowded_message"]
+__all__ = [
+    "MARK_MOVES",
+    "NOT_HOLDING",
+    "NO_BASKET_HOLD",
+    "PAST_THE_OPENING",
+    "TUCKING_FIRST",
+    "crowded_message",
+]
 
 #: Which way (unit vector, `base` xy) a refused place mark should move, by the words the
 #: refusal ends with (`crowded_message`).
@@ -30,6 +37,9 @@ NO_BASKET_HOLD = "Held that way, the object could not be held over the basket."
 
 #: The failure of a behaviour that needs the hand to hold something, when it holds nothing.
 NOT_HOLDING = "The hand is not holding anything."
+
+#: Said as the carry to the basket goes by the tucked pose, out of a narrow gap.
+TUCKING_FIRST = "Tucking the object in on the way to the basket."
 
 
 def crowded_message(points: np.ndarray, spot: np.ndarray) -> str:

@@ -121,11 +121,14 @@ def joint_path_via(
     s: MotionSettings,
     via: Sequence[np.ndarray] = (),
     turn_goals: bool = False,
+    reached: list[np.ndarray] | None = None,
     **kw,
 ) -> np.ndarray | None:
     """`joint_path` to q_goal (6,) or to the first reached of goals (k, 6) rad; where it finds
     none, through each configuration of `via` (6,) rad in turn: two shorter searches
-    instead of one long. None where no search found a path.
+    instead of one long. None where no search found a path. reached: where given, each
+    path found to a configuration of `via` is appended to it, whether or not the way on
+    from there was found.
 
     turn_goals: the goals hold the hand where its wrists' whole turns are free (a posture
     over the basket): the leg on from a via pose searches them with the wrists turned the
@@ -140,6 +143,8 @@ def joint_path_via(
         if turn_goals:
             goals = np.array([nearest_turns(goal, q_via) for goal in goals])
         first = joint_path(q_start, q_via, checker, rng, s, **kw)
+        if first is not None and reached is not None:
+            reached.append(first)
         second = joint_path(q_via, goals, checker, rng, s, **kw) if first is not None else None
         path = None if second is None else np.vstack([first, second[1:]])
     return path

@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from laserpick.behaviours import CARRY_PLANNING, Outcome
+from laserpick.behaviours import CARRY_PLANNING, TUCKING_FIRST, Outcome
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasp_choice import find_grasps
@@ -144,7 +144,7 @@ class Jobs(Retreat, Foresight):
         if out.failure is not None and out.failure.kind == "ik_plan" and b.held is not None:
             # No way to the basket from where the lift left the object (in a narrow gap, say):
             # it is tucked in and carried from there.
-            self._progress("Tucking the object in on the way to the basket.")
+            self._progress(TUCKING_FIRST)
             tucked = b.tuck()
             self._count_carry_planning(tucked)
             if not tucked.ok:
