@@ -490,31 +490,6 @@ def test_an_object_with_no_way_to_the_basket_from_where_it_was_lifted_is_tucked_
         session.close()
 
 
-def test_a_drop_that_found_no_way_from_the_tucked_pose_is_not_tried_again() -> None:
-    """Where the drop's carry went by the tucked pose and found no way on from there, the
-    session does not tuck the object in and search the same way again: the drop fails once,
-    and the session retreats with the object in the hand. The planner's "no way" is stood
-    in for here, after a real tuck: the isolation scene's mug has a clear one."""
-    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
-    try:
-        robot, actor, b = session.robot, Actor("bench"), session.behaviours
-        robot.sleep(0.3)
-        drops: list[bool] = []
-
-        def drop_found_no_way_from_the_tuck() -> Outcome:
-            assert b.tuck().ok
-            drops.append(b.is_tucked())
-            return Outcome(Failure("ik_plan", "No collision-free path was found."))
-
-        b.drop_in_basket = drop_found_no_way_from_the_tuck  # type: ignore[method-assign]
-        _fetch_mug(session, actor, "pick_and_drop")
-        assert drops == [True]
-        assert session.failure is not None and session.failure.kind == "ik_plan"
-        assert b.held is not None and b.is_tucked()
-    finally:
-        session.close()
-
-
 def test_the_dead_man_is_handed_over_again_only_when_the_holder_is_heard_again() -> None:
     """While a drive runs and its holder says nothing, the controller keeps the one deadline
     it was handed: the watchdog's tick posts nothing to the sim thread until the holder is

@@ -154,15 +154,6 @@ class Carrying(GuardedMotion):
         msg = f"The object fell from the hand while it was carried to {where}."
         return Outcome(Failure("execute", msg))
 
-    def is_tucked(self) -> bool:
-        """Whether the hand holds an object and the arm holds it at its tucked pose
-        (`holding_poses`), within `start_tolerance` (rad, each joint)."""
-        if self.held is None:
-            return False
-        tucked, _ = holding_poses(self.held, self.settings)
-        off = np.abs(self.current_q() - tucked).max()
-        return bool(off <= self.settings.behaviour.start_tolerance)
-
     def tuck(self) -> Outcome:
         """Hold what the hand holds folded back beside the scooter (`dims.UR5_CARRY_Q`) while
         the user drives and marks where it goes: out of the cameras' view, the laser's way and

@@ -141,10 +141,9 @@ class Jobs(Retreat, Foresight):
         b = self.behaviours
         out = b.drop_in_basket()
         self._count_carry_planning(out)
-        no_way = out.failure is not None and out.failure.kind == "ik_plan"
-        if no_way and b.held is not None and not b.is_tucked():
+        if out.failure is not None and out.failure.kind == "ik_plan" and b.held is not None:
             # No way to the basket from where the lift left the object (in a narrow gap, say):
-            # it is tucked in and carried from there, unless the carry went by there already.
+            # it is tucked in and carried from there.
             self._progress(TUCKING_FIRST)
             tucked = b.tuck()
             self._count_carry_planning(tucked)
