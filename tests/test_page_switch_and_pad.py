@@ -143,12 +143,26 @@ def test_one_switch_scanning_pick(browser, server: ServeProcess) -> None:
         wait_state(server, lambda s: s["selection"] == "manual", 5)
         sw.select("Auto", within="Grasps group")
         wait_state(server, lambda s: s["selection"] == "auto", 5)
-        sw.select("Go", within="Grasps group")
-        t_go = time.monotonic()
+        t_go = go(sw, server)
         finish_pick(server, t_go)
         print(f"scanning pick: {sw.presses} presses, {time.monotonic() - t0:.1f} s")
     finally:
         close_page(page)
+
+
+def go(sw: Switch, server: ServeProcess, tries: int = 3) -> float:
+    """Press on Go, and again, as a person would, where the pick has not started some scan
+    periods later (on a loaded machine the page may take a press for the entry after Go).
+    The time (monotonic s) of the press that started it."""
+    for _ in range(tries):
+        sw.select("Go", within="Grasps group")
+        pressed = time.monotonic()
+        try:
+            wait_state(server, lambda s: s["state"] == "executing" or s["busy"], 8 * sw.period)
+            return pressed
+        except TimeoutError:
+            continue
+    raise AssertionError(f"the pick did not start after {tries} presses on Go")
 
 
 # --- 2. STOP, driving and the gamepad ----------------------------------------------------
