@@ -83,6 +83,8 @@ def basket_way(
     drops = drop_postures_for(q_from, held, settings)
     reached: list[np.ndarray] = []
     path = path_to_a_drop(q_from, drops, held, settings, rng, reached) if drops else None
+    if path is not None or not reached:
+        return BasketWay(drops, path)
     tucked = holding_poses(held, settings)[0]
     tucking = next((leg for leg in reached if np.array_equal(leg[-1], tucked)), None)
-    return BasketWay(drops, path, None if path is not None else tucking)
+    return BasketWay(drops, None, tucking)
