@@ -196,3 +196,40 @@ def test_together_one_full_search_goes_toward_every_pre_grasp(monkeypatch, unsee
     else:
         assert full == [list(range(1, 7))]
         assert grasp is found.ordered()[2] and np.allclose(plan.transit.q[-1], pres[2])
+
+
+@pytest.mark.parametrize("max_failed", [6, 3])
+def test_together_goes_on_grasp_by_grasp_where_the_searches_toward_all_found_no_way(
+    monkeypatch, max_failed
+) -> None:
+    """With `grasps_together`, where the full searches toward all six pre-grasps found no
+    way, from ready and again from the high ready pose, the budget left goes to the grasps
+    one by one: the way to the fourth, found alone, is taken. With three failed searches
+    allowed, the first grasp's own search spends them and the pick says no."""
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(6)])
+    pres = [ik_tcp(pregrasp_pose(g.pose, 0.10), g.ik)[0] for g in found.ordered()]
+    searched: list[list[int]] = []  # the grasps each full search went toward
+
+    def search(a, b, checker, rng, s, **kw):
+        goals = np.atleast_2d(b)
+        if np.allclose(goals[0], dims.UR5_HIGH_READY_Q):
+            return np.array([a, goals[0]], float)  # the fixed way up is clear
+        if s.rrt_max_samples <= first_plan.QUICK_SAMPLES:
+            return None
+        rows = [next(k for k, p in enumerate(pres, 1) if np.allclose(g, p)) for g in goals]
+        searched.append(rows)
+        return np.array([a, goals[0]], float) if rows == [4] else None
+
+    monkeypatch.setattr(joint_search, "joint_path", search)
+    s = get_settings().motion.model_copy(update={"rrt_max_failed": max_failed})
+    assert s.grasps_together
+    plan, grasp, _ = plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0), settings=s)
+    together = [list(range(1, 7))] * 2
+    if max_failed == 3:
+        assert isinstance(plan, Failure) and grasp is None
+        assert plan.message.startswith("No collision-free path in 3 searches")
+        assert searched == [*together, [1]]
+        return
+    assert not isinstance(plan, Failure), plan
+    assert searched == [*together, [1], [2], [3], [4]]
+    assert grasp is found.ordered()[3] and np.allclose(plan.transit.q[-1], pres[3])

@@ -91,7 +91,10 @@ def plan_first(
     pre-grasp, those are planned once more, best first, through the high ready pose first
     and with the failed legs searched anew: a search held to seen space finds a narrow way
     on some draws and not others, and a pick with one grasp left had one search between it
-    and "no". Returns the plan (or the last failure, which says so when ways through space
+    and "no". With `grasps_together`, where that pass found no way either, the budget left
+    goes to those grasps one by one: a search toward many goals spreads its samples over
+    them, and a juice bottle on a high table whose every together search failed, try after
+    try, was picked grasp by grasp. Returns the plan (or the last failure, which says so when ways through space
     the cameras did not see were left untaken), its grasp and its place in the order (or
     how many grasps were tried).
     """
@@ -114,6 +117,8 @@ def plan_first(
         searches.forget_failed()
         again = (UR5_HIGH_READY_Q, *via[:1])
         last = full(replace(pick, admit=None), first.no_way, s, again, searches)
+        if last.grasp is None and s.grasps_together and last.no_way and not searches.spent:
+            last = _plan_in_order(replace(pick, admit=None), last.no_way, s, again, searches)
     if last.grasp is not None:
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
