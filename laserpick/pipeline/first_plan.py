@@ -94,9 +94,11 @@ def plan_first(
     and "no". With `grasps_together`, where that pass found no way either, the budget left
     goes to those grasps one by one: a search toward many goals spreads its samples over
     them, and a juice bottle on a high table whose every together search failed, try after
-    try, was picked grasp by grasp. Returns the plan (or the last failure, which says so when ways through space
-    the cameras did not see were left untaken), its grasp and its place in the order (or
-    how many grasps were tried).
+    try, was picked grasp by grasp.
+
+    Returns the plan (or the last failure, which says so when ways through space the
+    cameras did not see were left untaken), its grasp and its place in the order (or how
+    many grasps were tried).
     """
     s = settings or get_settings().motion
     grasps = list(found.ordered() if order is None else order)

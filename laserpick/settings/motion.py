@@ -144,11 +144,12 @@ class MotionSettings(BaseModel):
         description="Once the first grasp's short search found no way, search the transit"
         " toward the other grasps' pre-grasps at once (short, one search for each way out),"
         " then toward all of them (full), and take the grasp it reaches, rather than a"
-        " search for each grasp, best first. Ours: grasp by grasp, a pick whose best grasps"
-        " have no way spends a search on each before one that has; on 17 fresh in-situ seeds"
-        " the pick planned in 0.70 s a try against 1.19 s, one task of 156 fewer done; on 8"
-        " fresh pick-place seeds 1.46 s against 2.18 s, three tasks of 96 fewer"
-        " (docs/pipeline.md).",
+        " search for each grasp, best first; where those find no way, the failed searches"
+        " left (rrt_max_failed) go to the grasps one by one. Ours: grasp by grasp, a pick"
+        " whose best grasps have no way spends a search on each before one that has; on 17"
+        " fresh in-situ seeds the pick planned in 0.70 s a try against 1.19 s, one task of"
+        " 156 fewer done; on 8 fresh pick-place seeds 1.72 s against 2.18 s, three tasks of"
+        " 96 fewer (docs/pipeline.md).",
     )
     rrt_max_failed: int = Field(
         6,
