@@ -117,10 +117,10 @@ def plan_first(
     last = first
     if first.grasp is None and first.no_way and not searches.spent:
         searches.forget_failed()
-        again = (UR5_HIGH_READY_Q, *via[:1])
-        last = full(replace(pick, admit=None), first.no_way, s, again, searches)
+        again, admitted = (UR5_HIGH_READY_Q, *via[:1]), replace(pick, admit=None)
+        last = full(admitted, first.no_way, s, again, searches)
         if last.grasp is None and s.grasps_together and last.no_way and not searches.spent:
-            last = _plan_in_order(replace(pick, admit=None), last.no_way, s, again, searches)
+            last = _plan_in_order(admitted, last.no_way, s, again, searches)
     if last.grasp is not None:
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
