@@ -304,3 +304,58 @@ def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back(
         assert np.linalg.norm(end[:3, 3] - let_go[:3, 3]) < 0.04
     finally:
         robot.close()
+
+
+def from_plus_y(x: float, y: float, z: float) -> np.ndarray:
+    """A TCP pose at (x, y, z) (m, `base`) with the hand level, approaching along -y and
+    closing across x."""
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    T[:3, 3] = x, y, z
+    return T
+
+
+def test_let_go_low_on_the_floor_the_open_hand_is_drawn_back_off_a_tall_box():
+    """A cereal box let go from the side 6 cm above the floor, its top 19 cm above the hand:
+    held to the floor's margin, the open hand has no way back that keeps it, and rises
+    straight up 10 cm with its fingers still about the box (the way to stand by from there
+    dragged the box 60 cm). Let go on the floor, the floor is its support, as on the way
+    down: the hand is drawn back off the box, the box stands where it stood, and the hand
+    then rises out of the floor's margin, where a way to stand by can start."""
+    robot = SimRobot(load_scene(str(DATA / "floor_box.yaml"), seed=1), realtime=False)
+    try:
+        robot.sim.settle(0.5)
+        referee = Referee(robot)
+        box = referee.position("cereal_box_1")
+        b = Behaviours(robot)
+        run = b.run  # the setup's own moves, not recorded
+        free = CollisionChecker(np.zeros((0, 3)))
+        low = from_plus_y(box[0], box[1] + 0.07, 0.063)  # 2.5 cm in from its +y face
+        out = from_plus_y(box[0], box[1] + 0.17, 0.12)  # clear of the floor's margin
+        q_out = next(q for q in ik_tcp(out, dims.UR5_READY_Q) if free.clearance_ok(q)[0])
+        assert b.go_ready().ok
+        assert b.go_to(q_out, free, "test", via=(dims.UR5_HIGH_READY_Q,)).ok
+        path = cartesian_line(q_out, low, b.settings.motion.cartesian_step)
+        assert path is not None
+        assert run(timed(path, b.settings.motion, tcp_speed=0.03), "in") is None
+        robot.sleep(0.3)
+        assert not robot.gripper_state().closed
+        assert not free.clearance_ok(robot.joint_state().q)[0], "within the floor's margin"
+        above = low.copy()
+        above[2, 3] += 0.10
+        moves = recorded_moves(b)
+        assert b.leave_object(above, free, on_floor=True) is None
+        assert moves[-2:] == ["drawing back", "rising off the floor"], moves
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        assert end[1] - low[1, 3] > 0.09, "drawn back 10 cm along the approach"
+        assert end[2] > above[2, 3] - 0.005, "and risen as high as it came down from"
+        assert free.clearance_ok(robot.joint_state().q)[0]
+        np.testing.assert_allclose(referee.position("cereal_box_1"), box, atol=0.005)
+        # Held to the floor's margin, as the place went by before: straight up instead.
+        assert b.go_to(q_out, free, "test").ok
+        assert run(timed(path, b.settings.motion, tcp_speed=0.03), "in") is None
+        moves.clear()
+        assert b.leave_object(above, free) is None
+        assert moves == ["rising from the object"]
+    finally:
+        robot.close()

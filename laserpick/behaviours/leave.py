@@ -30,7 +30,9 @@ class Leaving(Withdrawing):
         eased[2, 3] += self.settings.motion.place_ease
         self.rise_straight(eased, "easing off the surface")
 
-    def leave_object(self, T_above: np.ndarray, checker: CollisionChecker) -> Failure | None:
+    def leave_object(
+        self, T_above: np.ndarray, checker: CollisionChecker, *, on_floor: bool = False
+    ) -> Failure | None:
         """Take the open hand off what it has just set down: drawn back along its approach
         if that way is clear of `checker` (which leaves the object out: the fingers start
         about it), else straight up to the TCP pose T_above (4, 4, `base`), the way it came
@@ -46,7 +48,16 @@ class Leaving(Withdrawing):
         first, comes free. Pads that still feel anything then are eased off it sideways
         (`_slide_pads_off`), and the hand leaves from there: risen straight up, it goes up
         beside the way it came down, by as much as it was eased (at most `leave_shift`),
-        unchecked as that way is."""
+        unchecked as that way is.
+
+        on_floor: it was let go on the floor, which is then its support, as on the way down
+        (`place_poses`): held to the floor's margin, a hand that let go of a tall box 6 cm
+        above the floor found no way back, rose with its fingers still about the box, and
+        the way to stand by dragged the box 60 cm. Drawn back off it low, the hand still
+        stands within the floor's margin, where no way to stand by can start: it then rises
+        as high as T_above, where that way up is clear."""
+        if on_floor:
+            checker = checker.floor_as_support()
         start = tcp_pose(self.current_q())
         approach = start[:3, 2]
         back = self.withdrawal_path(approach, checker, level=False)
@@ -64,7 +75,24 @@ class Leaving(Withdrawing):
             T_up[:3, 3] += eased
             self.rise_straight(T_up, "rising from the object")
             return None
-        return self.run_withdrawal(back)
+        failure = self.run_withdrawal(back)
+        if failure is None and on_floor:
+            self._rise_to(float(T_above[2, 3]), checker)
+        return failure
+
+    def _rise_to(self, height: float, checker: CollisionChecker) -> None:
+        """Rise straight up to `height` (m, `base` z of the TCP), at the approach speed, if
+        the way up keeps the clearance from `checker` that the hand starts with."""
+        s = self.settings.motion
+        q = self.current_q()
+        T = tcp_pose(q)
+        kept = checker.clearance_kept(q)
+        if kept is None or T[2, 3] >= height:
+            return
+        T[2, 3] = height
+        up = cartesian_line(q, T, s.cartesian_step)
+        if up is not None and checker.all_clear(up, margin=kept):
+            self.run(timed(up, s, tcp_speed=s.approach_speed), "rising off the floor")
 
     def free_the_pads(self, checker: CollisionChecker) -> bool:
         """Where the open hand's pads still press what it let go of (`pads_clear`), lower

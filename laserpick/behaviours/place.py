@@ -20,7 +20,7 @@ from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import CollisionChecker, not_carried, obstacle_mask
-from laserpick.pipeline.surface import place_target
+from laserpick.pipeline.surface import on_floor, place_target
 from laserpick.types import Failure, FusedCloud
 
 __all__ = ["Placing"]
@@ -75,7 +75,7 @@ class Placing(Carrying, Leaving, Stowing):
         if failure is not None:
             return Outcome(failure).planned_for(planning)
         T_release = tcp_pose(self.current_q())
-        failure = self.leave_object(poses.T_above, checker)
+        failure = self.leave_object(poses.T_above, checker, on_floor=on_floor(float(spot[2])))
         if failure is not None:
             return Outcome(failure, held.grasp, spot=spot).planned_for(planning)
         placed = self._stand_by_around_placed(held, T_release, checker, spot)

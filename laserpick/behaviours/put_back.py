@@ -8,6 +8,7 @@ from laserpick.behaviours.messages import NOT_HOLDING
 from laserpick.behaviours.outcome import Outcome
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.recall import moved
+from laserpick.pipeline.surface import on_floor
 from laserpick.types import Failure
 
 __all__ = ["PuttingBack"]
@@ -59,7 +60,8 @@ class PuttingBack(Leaving):
         # Out along the approach, as far above the way in as the hand stands above the grasp.
         T_out = tcp_pose(way.approach[0])
         T_out[:3, 3] += tcp_pose(self.current_q())[:3, 3] - T_grasp[:3, 3]
-        failure = self.leave_object(T_out, held.surroundings)
+        stood_on = float(T_grasp[2, 3]) - held.height_above_support
+        failure = self.leave_object(T_out, held.surroundings, on_floor=on_floor(stood_on))
         if failure is not None:
             return Outcome(failure, held.grasp)
         self.progress("Put back.")
