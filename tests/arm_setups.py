@@ -3,6 +3,7 @@ pick as a session makes it."""
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -30,13 +31,23 @@ SETTINGS = get_settings()
 BEHAVIOUR = SETTINGS.behaviour
 
 
+@contextlib.contextmanager
+def scene_robot(scene: str) -> Iterator[SimRobot]:
+    """A robot in `scene` (a built-in scene's name or a scene file's path, seed 1), settled,
+    run as fast as it goes; closed after."""
+    r = SimRobot(load_scene(scene, seed=1), realtime=False)
+    try:
+        r.sim.settle(0.5)
+        yield r
+    finally:
+        r.close()
+
+
 def isolation_robot() -> Iterator[SimRobot]:
     """The isolation scene (seed 1), settled, run as fast as it goes; closed after. For a
     fixture: `yield from isolation_robot()`."""
-    r = SimRobot(load_scene("isolation", seed=1), realtime=False)
-    r.sim.settle(0.5)
-    yield r
-    r.close()
+    with scene_robot("isolation") as r:
+        yield r
 
 
 def top_down(x: float, y: float, z: float) -> np.ndarray:

@@ -19,6 +19,7 @@ from arm_setups import (
     box_points,
     isolation_robot,
     pick_object,
+    scene_robot,
 )
 from basket import assert_in_basket
 
@@ -52,7 +53,6 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.motion_limits import motion_limits
 from laserpick.pipeline.perceive import perceive
-from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotz
 from laserpick.types import Grasp
@@ -408,17 +408,13 @@ def test_a_pick_for_the_basket_takes_no_grasp_it_could_not_drop_from(robot):
 
 
 def test_a_tall_object_is_picked_and_dropped_in_the_basket():
-    robot = SimRobot(load_scene(str(DATA / "tall_object.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "tall_object.yaml")) as robot:
         name = "cereal_box_1"
         b, referee = pick_object(robot, name)
         dropped = b.drop_in_basket()
         assert dropped.ok, dropped.failure
         robot.sleep(1.0)
         assert referee.in_basket(name)
-    finally:
-        robot.close()
 
 
 # --- the judge of the live tests' drops (tests/basket.py) ----------------------------------------

@@ -13,6 +13,7 @@ from arm_setups import (
     hand_at,
     isolation_robot,
     post_behind,
+    scene_robot,
     side_pose,
     top_down,
 )
@@ -24,8 +25,6 @@ from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
-from laserpick.robot.sim.robot import SimRobot
-from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import rotx
 from laserpick.types import Failure, Trajectory
 
@@ -98,9 +97,7 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
     and drawn back from there, drag it (196 N, a protective stop). Here the open hand
     stands level 2 mm over a table top: lowered, it meets the table, stops, goes back up
     to where it stood, and is drawn back from there, level."""
-    robot = SimRobot(load_scene(str(DATA / "table_top.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "table_top.yaml")) as robot:
         b = Behaviours(robot)
         run = b.run  # the setup's own moves, not recorded
         moves = recorded_moves(b)
@@ -131,8 +128,6 @@ def test_an_open_hand_lowered_onto_something_goes_back_up_before_it_draws_back()
         assert moves == ["freeing the fingers", "rising off what the fingers met", "drawing back"]
         moved = tcp_pose(robot.joint_state().q)[:3, 3] - start
         np.testing.assert_allclose(moved, [-0.10, 0.0, 0.0], atol=0.0025)
-    finally:
-        robot.close()
 
 
 @pytest.mark.parametrize("lean", [0.026, -0.026], ids=["first-way-in", "first-way-out"])
@@ -145,9 +140,7 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
     its closing axis. The gripper feels only the pads' sum, not which pad, so the first
     way it tries may push into the bottle: the guard stops it there, and the other way
     frees the pad."""
-    robot = SimRobot(load_scene(str(DATA / "pill_lean.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "pill_lean.yaml")) as robot:
         referee = Referee(robot)
         bottle = referee.position("pill_bottle_1")
         b = Behaviours(robot)
@@ -187,8 +180,6 @@ def test_an_open_hand_a_light_object_leans_on_is_eased_off_it_before_it_rises(le
         shift = BEHAVIOUR.leave_shift
         np.testing.assert_allclose(end[1], start[1, 3] - np.sign(lean) * shift, atol=0.003)
         assert end[2] > z + 0.09, "and the hand rose"
-    finally:
-        robot.close()
 
 
 def _press_a_pad_on_the_rail(b: Behaviours) -> None:
@@ -211,9 +202,7 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
     free. An open hand whose pads still press something is lowered first from any
     approach, guarded over what the pads already bear, then eased sideways off it. Here
     the open hand straddles a rail from above, one pad pressed against it."""
-    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "rail.yaml")) as robot:
         b = Behaviours(robot)
         moves = recorded_moves(b)
         free = CollisionChecker(np.zeros((0, 3)))
@@ -235,8 +224,6 @@ def test_an_open_hand_whose_pads_still_press_something_is_lowered_before_it_leav
         shift, drop = BEHAVIOUR.leave_shift, BEHAVIOUR.leave_drop
         assert above[1, 3] - shift - 0.003 < end[1] < above[1, 3] - shift / 2
         assert above[2, 3] - drop - 0.003 < end[2] < above[2, 3] + 0.003
-    finally:
-        robot.close()
 
 
 def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises():
@@ -244,9 +231,7 @@ def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises
     spray bottle wedged against a pad was lifted out with it): an open hand whose pads feel
     nothing does not move; one whose pad presses a rail is lowered and eased off it, and
     its pads then feel nothing."""
-    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "rail.yaml")) as robot:
         b = Behaviours(robot)
         free = CollisionChecker(np.zeros((0, 3)))
         hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
@@ -258,8 +243,6 @@ def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises
         assert moves[0] == "freeing the fingers" and "easing the pads off" in moves
         robot.sleep(BEHAVIOUR.leave_settle)
         assert robot.gripper_state().force <= BEHAVIOUR.pads_clear
-    finally:
-        robot.close()
 
 
 def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back():
@@ -269,9 +252,7 @@ def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back(
     where it let go; only as far as that turn is clear (here, not at all). The rail scene
     cannot hang an object from a pad: here the pads read pressed while the hand tilts more
     than 5 deg."""
-    robot = SimRobot(load_scene(str(DATA / "rail.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "rail.yaml")) as robot:
         b = Behaviours(robot)
         tilted = top_down(1.30, 0.0, RAIL_TOP + 0.20)
         tilted[:3, :3] = rotx(np.radians(30)) @ tilted[:3, :3]
@@ -302,8 +283,6 @@ def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back(
         np.testing.assert_allclose(end[:3, :3], let_go[:3, :3], atol=0.02)
         # Only lowered (`leave_drop`) and eased sideways (`leave_shift`) before the turns.
         assert np.linalg.norm(end[:3, 3] - let_go[:3, 3]) < 0.04
-    finally:
-        robot.close()
 
 
 def from_plus_y(x: float, y: float, z: float) -> np.ndarray:
@@ -322,9 +301,7 @@ def test_let_go_low_on_the_floor_the_open_hand_is_drawn_back_off_a_tall_box():
     dragged the box 60 cm). Let go on the floor, the floor is its support, as on the way
     down: the hand is drawn back off the box, the box stands where it stood, and the hand
     then rises out of the floor's margin, where a way to stand by can start."""
-    robot = SimRobot(load_scene(str(DATA / "floor_box.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "floor_box.yaml")) as robot:
         referee = Referee(robot)
         box = referee.position("cereal_box_1")
         b = Behaviours(robot)
@@ -357,5 +334,3 @@ def test_let_go_low_on_the_floor_the_open_hand_is_drawn_back_off_a_tall_box():
         moves.clear()
         assert b.leave_object(above, free) is None
         assert moves == ["rising from the object"]
-    finally:
-        robot.close()

@@ -5,11 +5,9 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from arm_setups import DATA
+from arm_setups import DATA, scene_robot
 
 from laserpick.description import dims
-from laserpick.robot.sim.robot import SimRobot
-from laserpick.robot.sim.scenes import load_scene
 from laserpick.robot.sim.truth import SimTruth, inside_basket, on_scooter
 
 FLOOR = dims.BASKET_FLOOR
@@ -41,9 +39,7 @@ def test_an_object_that_missed_the_basket_and_lies_on_the_scooter_is_on_it():
 def test_a_box_standing_on_its_top_in_the_basket_is_in_it():
     """A 25 cm cereal box that came to rest on its top in the basket: its origin (the middle
     of its bottom face) is 9 cm over the rim, its centre of mass inside."""
-    robot = SimRobot(load_scene(str(DATA / "tall_object.yaml"), seed=1), realtime=False)
-    try:
-        robot.sim.settle(0.5)
+    with scene_robot(str(DATA / "tall_object.yaml")) as robot:
         truth = SimTruth(robot)
         name = "cereal_box_1"
         height = truth.centre_of_mass(name)[2] - truth.position(name)[2]  # half its height
@@ -60,5 +56,3 @@ def test_a_box_standing_on_its_top_in_the_basket_is_in_it():
         assert truth.in_basket(name)
         truth.take_out(name)
         assert not truth.in_basket(name)
-    finally:
-        robot.close()
