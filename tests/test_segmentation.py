@@ -342,3 +342,56 @@ def test_object_tops_in_line_are_not_a_surface():
     assert abs(seg.surface.height - 0.5) < 0.005
     rim_top = cloud.points[len(table) : len(table) + len(ring)][:, 2].max()
     assert cloud.points[seg.indices, 2].max() > rim_top - 0.003, "the rim is part of the bowl"
+
+
+def _thinning_packet(rng: np.random.Generator, gaps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A lying 5 cm wide packet 3 cm tall on the table patch of `_box_on_patch`, its top seen
+    well on its near 5 cm (3 mm grid), then thinly: rows across it `gaps` (m) apart, 4 mm
+    between points along a row, as at a growing grazing angle. Returns (points, packet mask)."""
+    table, n_box = _box_on_patch(rng)
+    table = table[:-n_box]
+    table = table[~((np.abs(table[:, 0] - 1.5) < 0.08) & (np.abs(table[:, 1]) < 0.03))]
+    near = np.meshgrid(np.arange(-0.05, 0.0, 0.003), np.arange(-0.025, 0.025, 0.003))
+    far = np.meshgrid(-0.002 + np.cumsum(gaps), np.arange(-0.025, 0.025, 0.004))
+    xy = np.concatenate([np.column_stack([a.ravel(), b.ravel()]) for a, b in (near, far)])
+    top = np.column_stack([1.5 + xy[:, 0], xy[:, 1], np.full(len(xy), 0.53)])
+    top += rng.normal(0, 0.0003, top.shape)
+    pts = np.concatenate([table, top])
+    packet = np.zeros(len(pts), bool)
+    packet[len(table) :] = True
+    return pts, packet
+
+
+#: Row gaps (m) growing from the near half's 3 mm to 7.5 mm, as on a lying tissue packet
+#: seen from about 1 m (3.7 mm median, 5.6 mm at the 90th percentile between points).
+THINNING = np.linspace(0.0035, 0.0075, 9)
+
+
+def test_a_thinly_seen_part_joins_the_target():
+    """Rows of a surface seen from afar lie further apart than the 5 mm tolerance: each is a
+    fragment, and within 1.5 times the local spacing of the points it continues, it joins."""
+    pts, packet = _thinning_packet(np.random.default_rng(3), THINNING)
+    cloud = _synthetic(pts)
+    mark = np.array([1.47, 0.0, 0.53], np.float32)
+    whole = segment_target(cloud, mark, SETTINGS)
+    assert isinstance(whole, Segmentation) and whole.method == "cluster"
+    assert iou(_mask(whole, len(cloud)), packet) > 0.95
+    apart = segment_target(cloud, mark, SETTINGS.model_copy(update={"fragment_gap_ratio": 0.0}))
+    assert isinstance(apart, Segmentation)
+    assert iou(_mask(apart, len(cloud)), packet) < 0.9, "without the rule it falls apart"
+
+
+def test_fragments_past_the_reach_or_beside_a_dense_object_stay_out():
+    """A row 12 mm past the thinning rows is past `fragment_gap_max`; a small cluster 7 mm
+    beside the well-seen part (its points 3 mm apart) is past 1.5 times their spacing:
+    neither joins."""
+    pts, packet = _thinning_packet(np.random.default_rng(4), np.append(THINNING, 0.012))
+    last_row = packet & (pts[:, 0] > pts[packet, 0].max() - 0.002)
+    gx, gy = np.meshgrid(np.arange(0.0, 0.012, 0.003), np.arange(0.0, 0.012, 0.003))
+    tuft = np.column_stack([1.46 + gx.ravel(), 0.032 + gy.ravel(), np.full(gx.size, 0.53)])
+    cloud = _synthetic(np.concatenate([pts, tuft]))
+    seg = segment_target(cloud, np.array([1.47, 0.0, 0.53], np.float32), SETTINGS)
+    assert isinstance(seg, Segmentation)
+    assert iou(_mask(seg, len(cloud))[: len(pts)], packet & ~last_row) > 0.95
+    assert not np.isin(np.flatnonzero(last_row), seg.indices).any()
+    assert not np.isin(np.arange(len(pts), len(cloud)), seg.indices).any()

@@ -3,7 +3,8 @@
 Two methods:
 
 - "cluster" (004 6.1): remove the roughly horizontal planes (RANSAC), extract Euclidean
-  clusters at 5 mm, keep the one nearest the mark; a cluster under 500 points gives way to a
+  clusters at 5 mm, keep the one nearest the mark (with the pieces an overhang or thin
+  coverage split from it: rejoin.py); a cluster under 500 points gives way to a
   0.1 m ball around the mark (less the other clusters in it: ours). 002 II.C adds a guard:
   a segment that swallowed more than 90 % of the points around the mark has merged with its
   support, and the 8 cm ball replaces it.
@@ -33,6 +34,7 @@ from laserpick.pipeline.planes import (
     remove_horizontal_planes,
     surface_inliers,
 )
+from laserpick.pipeline.rejoin import fragment_labels, min_cluster_points, overhang_labels
 from laserpick.pipeline.surface import surface_height, voi_mask
 from laserpick.settings import PerceptionSettings
 from laserpick.types import Failure, FusedCloud, Segmentation, SupportSurface
@@ -47,16 +49,6 @@ NOTHING_SEEN = "The mark is not on anything my cameras can see."
 
 #: 26-connectivity in a 3D grid (000 4.2.2).
 _TWENTY_SIX = np.ones((3, 3, 3), bool)
-
-
-def min_cluster_points(settings: PerceptionSettings) -> int:
-    """Points the target cluster needs before the ball replaces it: 004's 500, scaled.
-
-    Like the plane inliers (see `min_plane_inliers`), 004's 500 counts full-resolution pixels
-    of its Structure sensors; we keep 1 / pixel_stride^2 of them, so 500 / stride^2 (125 at
-    stride 2) asks for the same visible object area.
-    """
-    return max(1, math.ceil(settings.cluster_min_points / settings.pixel_stride**2))
 
 
 # --- Euclidean clusters (004 6.1) -------------------------------------------------------------
@@ -165,7 +157,8 @@ def _segment_cluster(
         # The mark is on a table with nothing standing there (a transparent cup reads as the
         # table under it): a ball here would be a piece of table.
         return Failure("precondition", NO_OBJECT)
-    target = _rejoin_overhangs(pts, idx, labels, labels[nearest], real, settings)
+    joined = overhang_labels(pts, idx, labels, labels[nearest], real, settings)
+    target = idx[np.isin(labels, list(fragment_labels(pts, idx, labels, joined, settings)))]
     method: Literal["cluster", "ball", "merged_radius"] = "cluster"
     if len(target) < min_cluster_points(settings):
         # 004's ball, less the other objects in it: the points of every other cluster of
@@ -182,47 +175,6 @@ def _segment_cluster(
     if len(target) > settings.merged_fraction * len(crop):
         target, method = np.flatnonzero(d2 <= settings.merged_radius**2), "merged_radius"
     return Segmentation(indices=np.sort(target), method=method, surface=surface)
-
-
-def _rejoin_overhangs(
-    pts: np.ndarray,
-    idx: np.ndarray,
-    labels: np.ndarray,
-    target_label: int,
-    real: np.ndarray,
-    settings: PerceptionSettings,
-) -> np.ndarray:
-    """Cloud indices of the target cluster (`idx[labels == target_label]`) plus the clusters
-    an overhang split from it.
-
-    Every sensor looks down, so the underside of an overhang (a doll's chin, a mug's rim
-    over its handle) is never seen, and the object can fall into an upper and a lower
-    cluster more than the 5 mm tolerance apart. A cluster within `occlusion_gap` of the target
-    whose top-down footprint mostly lies inside the target's (or the target's inside its)
-    is taken to be the same object. Objects standing apart on a table do not overlap seen
-    from above, so this does not merge neighbours. Our addition to 004.
-    """
-    target = idx[labels == target_label]
-    if settings.occlusion_gap <= 0:
-        return target
-    tree = cKDTree(pts[target])
-    lo, hi = pts[target, :2].min(axis=0) - 0.005, pts[target, :2].max(axis=0) + 0.005
-    joined = [target]
-    for label in np.unique(labels[real]):
-        if label == target_label:
-            continue
-        other = idx[labels == label]
-        if np.min(tree.query(pts[other], distance_upper_bound=settings.occlusion_gap)[0]) > (
-            settings.occlusion_gap
-        ):
-            continue
-        xy = pts[other, :2]
-        inside = np.mean(np.all((xy >= lo) & (xy <= hi), axis=1))
-        olo, ohi = xy.min(axis=0) - 0.005, xy.max(axis=0) + 0.005
-        covered = np.mean(np.all((pts[target, :2] >= olo) & (pts[target, :2] <= ohi), axis=1))
-        if inside > 0.5 or covered > 0.5:
-            joined.append(other)
-    return np.concatenate(joined) if len(joined) > 1 else target
 
 
 def _segment_grid(

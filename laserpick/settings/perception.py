@@ -193,6 +193,25 @@ class PerceptionSettings(BaseModel):
             " Ours."
         ),
     )
+    fragment_gap_ratio: float = Field(
+        1.5,
+        ge=0,
+        description=(
+            "A cluster too small to be an object (under 500 / pixel_stride^2 points) joins the"
+            " target when this many times the local spacing of the target's points (the"
+            " distance to their 4th nearest neighbour) from it: where the cameras see a"
+            " surface from afar or at a grazing angle its points thin out and the 5 mm"
+            " clustering splits it. 0 turns it off. Ours."
+        ),
+    )
+    fragment_gap_max: float = Field(
+        0.01,
+        ge=0,
+        description=(
+            "The farthest (m) a fragment may lie from the target and join it, however sparse"
+            " the points: twice 004's 5 mm. Ours."
+        ),
+    )
     cluster_noise_points: int = Field(
         10,
         ge=1,
