@@ -1,5 +1,6 @@
 """What an adapter tells its user: every line on stdout with the time since the adapter
-started (s, monotonic clock), and, with `--speak`, the short spoken form through espeak-ng.
+started at which it happened (s, monotonic clock, which the runner shares), and, with
+`--speak`, the short spoken form through espeak-ng.
 
     [    3.000] highlight laser.up
     [    3.412] lost the server at http://127.0.0.1:8000: connection refused
@@ -45,15 +46,22 @@ class Announcer:
         if speak and self._speaker is None:
             self.note(f"{SPEAKER} is not installed: announcing on stdout only")
 
-    def note(self, text: str) -> None:
-        """A line on stdout only (connection news, refusals)."""
+    def note(self, text: str, at: float | None = None) -> None:
+        """A line on stdout only (connection news, refusals), stamped `at` (s on `clock`;
+        default now)."""
         with self._lock:
             stream = self.out or sys.stdout
-            print(f"[{self.clock() - self.t0:9.3f}] {text}", file=stream, flush=True)
+            t = self.clock() if at is None else at
+            print(f"[{t - self.t0:9.3f}] {text}", file=stream, flush=True)
 
-    def say(self, text: str, spoken: str | None = None) -> None:
-        """A line on stdout, and `spoken` (default the text) through speech when enabled."""
-        self.note(text)
+    def say(self, text: str, spoken: str | None = None, at: float | None = None) -> None:
+        """A line on stdout, and `spoken` (default the text) through speech when enabled.
+
+        `at` (s on `clock`; default now): when what it announces happened. A scan step is
+        stamped with the time it was due, so the log keeps the schedule when a loaded
+        machine prints the line late (84 ms once, under the full test suite).
+        """
+        self.note(text, at)
         if self._speaker is not None:
             self._speak(spoken or text)
 

@@ -129,7 +129,7 @@ class SwitchAdapter:
     def _emit(self, outputs: list[Output]) -> None:
         for o in outputs:
             if isinstance(o, Highlight):
-                self.say.say(f"highlight {o.key}", o.label)
+                self.say.say(f"highlight {o.key}", o.label, at=o.t)
             elif isinstance(o, Selected):
                 self.say.say(f"select {o.item.key}", o.item.label)
                 self._act(o.item)
