@@ -12,6 +12,7 @@ import pytest
 from laserpick.bench.scoring import iou
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.planes import min_plane_inliers, remove_horizontal_planes
+from laserpick.pipeline.rejoin import fragment_labels
 from laserpick.pipeline.segment import (
     NO_OBJECT,
     NOTHING_SEEN,
@@ -395,3 +396,19 @@ def test_fragments_past_the_reach_or_beside_a_dense_object_stay_out():
     assert iou(_mask(seg, len(cloud))[: len(pts)], packet & ~last_row) > 0.95
     assert not np.isin(np.flatnonzero(last_row), seg.indices).any()
     assert not np.isin(np.arange(len(pts), len(cloud)), seg.indices).any()
+
+
+def test_a_fragment_within_a_planes_band_stays_out():
+    """A fragment in reach whose every point lies within a removed plane's 1.5 cm is as
+    likely the support's noise (a floor seen from 1.5 m): only one with a point off every
+    plane joins."""
+    rows = [np.column_stack([np.full(12, x), np.arange(12) * 0.004]) for x in (0.0, 0.006)]
+    xy = np.concatenate(rows)
+    target = np.column_stack([xy, np.full(len(xy), 0.01)])  # a flat thing, 1 cm tall
+    pts = target.astype(np.float32)
+    labels = np.repeat([0, 1], 12)
+    idx = np.arange(len(pts))
+    off_planes = np.ones(len(pts), bool)
+    assert fragment_labels(pts, idx, labels, {0}, off_planes, SETTINGS) == {0, 1}
+    off_planes[12:] = False  # the piece wholly within the band
+    assert fragment_labels(pts, idx, labels, {0}, off_planes, SETTINGS) == {0}

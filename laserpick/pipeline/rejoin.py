@@ -79,23 +79,34 @@ def overhang_labels(
 
 
 def fragment_labels(
-    pts: np.ndarray, idx: np.ndarray, labels: np.ndarray, joined: set[int], settings
+    pts: np.ndarray,
+    idx: np.ndarray,
+    labels: np.ndarray,
+    joined: set[int],
+    off_planes: np.ndarray,
+    settings: PerceptionSettings,
 ) -> set[int]:
     """`joined` and the small clusters that continue it where its points thin out.
 
-    A fragment (a cluster of fewer than `min_cluster_points`, too small to be taken for an
-    object) joins when it lies within `fragment_gap_ratio` times the local spacing of the
-    target's point nearest it (that point's distance to their 4th nearest neighbour), never further
-    than `fragment_gap_max`. Where the target is dense the reach stays at the 5 mm tolerance,
-    so a neighbour or speckle beside a well-seen object stays out; where it is sparse a missed
-    pixel or two is bridged. Joined fragments extend the front, so a chain of them joins.
+    A fragment joins when it lies within `fragment_gap_ratio` times the local spacing of the
+    target's point nearest it (that point's distance to its 4th nearest neighbour), never
+    further than `fragment_gap_max`. Where the target is dense the reach stays at the 5 mm
+    tolerance, so a neighbour or speckle beside a well-seen object stays out; where it is
+    sparse a missed pixel or two is bridged. Joined fragments extend the front, so a chain
+    of them joins.
+
+    A fragment is a cluster of fewer than `min_cluster_points` (too small to be taken for an
+    object) with a point off every removed plane (`off_planes`, (len(idx),) bool): a piece
+    wholly within a plane's 1.5 cm is as likely the support's depth noise, which on a floor
+    seen from 1.5 m joined a phone.
     """
     ratio, reach = settings.fragment_gap_ratio, settings.fragment_gap_max
     if ratio <= 0 or reach <= settings.cluster_tolerance:
         return joined
     sizes = np.bincount(labels)
     member = np.isin(labels, list(joined))
-    free = ~member & (sizes[labels] < min_cluster_points(settings))
+    lifted = np.bincount(labels, weights=off_planes, minlength=len(sizes)) > 0
+    free = ~member & (sizes[labels] < min_cluster_points(settings)) & lifted[labels]
     if not free.any():
         return joined
     cloud = pts[idx]

@@ -158,7 +158,8 @@ def _segment_cluster(
         # table under it): a ball here would be a piece of table.
         return Failure("precondition", NO_OBJECT)
     joined = overhang_labels(pts, idx, labels, labels[nearest], real, settings)
-    target = idx[np.isin(labels, list(fragment_labels(pts, idx, labels, joined, settings)))]
+    joined = fragment_labels(pts, idx, labels, joined, keep[idx], settings)
+    target = idx[np.isin(labels, list(joined))]
     method: Literal["cluster", "ball", "merged_radius"] = "cluster"
     if len(target) < min_cluster_points(settings):
         # 004's ball, less the other objects in it: the points of every other cluster of
