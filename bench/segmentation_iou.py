@@ -33,8 +33,7 @@ def _parked_at(scene: Scene, instance: str) -> Scene:
     p = scene.placement(instance)
     surface = scene.surface(p.surface)
     x, y = (float(v) for v in surface.to_local(np.asarray(p.pos[:2])))
-    floor_x = x if surface.kind == "floor" else None
-    pose = parking_pose(surface, y, surface.levels[p.level], floor_x)
+    pose = parking_pose(surface, y, surface.levels[p.level], x)  # x counts on a floor only
     return dataclasses.replace(scene, scooter_pose=tuple(float(v) for v in pose))
 
 
