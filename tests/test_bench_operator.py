@@ -3,7 +3,6 @@ hand, how the helper tidies after an attempt, and the protocols' scenes."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,6 @@ from laserpick.bench.picking import (
     BENCH,
     LEVER_MAX,
     ScriptedOperator,
-    lever,
     open_session,
     seen_middle,
 )
@@ -25,6 +23,7 @@ from laserpick.bench.protocols.pick_place import coin_flip_kitchen
 from laserpick.bench.referee import Referee
 from laserpick.bench.route_planning import parked_clear
 from laserpick.description import dims
+from laserpick.pipeline.balance import hold_lever
 from laserpick.pipeline.cloud import fuse
 from laserpick.robot.sim.scenes import load_scene, scene_config
 from laserpick.robot.sim.truth import capture
@@ -90,21 +89,6 @@ def test_the_user_sees_whether_the_dot_is_on_the_object() -> None:
         cap.close()
 
 
-def test_a_grasps_lever_is_its_objects_weight_arm_about_the_line_between_the_fingers() -> None:
-    """Hand-worked: fingers closing along y at the origin; the weight 5 cm ahead (x) turns
-    the object about them with a 5 cm arm, wherever it lies along that line or below it."""
-    pose = np.eye(4)  # closing axis: the pose's y column
-    assert lever(pose, np.array([0.05, 0.30, -0.02])) == pytest.approx(0.05)
-    assert lever(pose, np.array([0.0, 0.07, -0.04])) == pytest.approx(0.0)
-    diagonal = np.eye(4)
-    diagonal[:3, 1] = [math.sqrt(0.5), math.sqrt(0.5), 0.0]
-    assert lever(diagonal, np.array([0.1, 0.1, 0.0])) == pytest.approx(0.0)
-    assert lever(diagonal, np.array([0.1, 0.0, 0.0])) == pytest.approx(0.1 * math.sqrt(0.5))
-    upright = np.eye(4)
-    upright[:3, 1] = [0.0, 0.0, 1.0]  # fingers above and below: the weight pulls along them
-    assert lever(upright, np.array([0.05, 0.05, 0.0])) == pytest.approx(0.0)
-
-
 def test_choosing_by_hand_the_user_holds_across_the_middle_and_toggles_on(tmp_path: Path) -> None:
     """A TV remote lying across the table. Seen whole, the middle of what the user sees is
     its middle, and the system's best cluster holds it there (G_b is the hand's bottom,
@@ -142,7 +126,7 @@ def test_choosing_by_hand_the_user_holds_across_the_middle_and_toggles_on(tmp_pa
             s.select_grasp(BENCH, k, 0)
             pose = np.asarray(s.status()["current"]["pose"])
             on.append(op.referee.object_at(pose[:3, 3], seen) == "remote")
-            levers.append(lever(pose, middle))
+            levers.append(hold_lever(pose, middle))
         assert on[0] and levers[0] > LEVER_MAX, "the best cluster should hold it off that middle"
         balanced = [k for k, x in enumerate(levers) if on[k] and x <= LEVER_MAX]
         op.choose("remote", seen)

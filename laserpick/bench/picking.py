@@ -25,6 +25,7 @@ import numpy as np
 from laserpick.behaviours import warm_drop_postures
 from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
+from laserpick.pipeline.balance import hold_lever
 from laserpick.pipeline.first_plan import at_rest
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
@@ -272,7 +273,7 @@ class ScriptedOperator:
                 continue
             at = self.referee.to_world(pose[:3, 3])
             tried = any(np.linalg.norm(at - p) < UNPLANNED_NEAR for p in failed)
-            rank = (tried, lever(pose, middle) > LEVER_MAX)
+            rank = (tried, hold_lever(pose, middle) > LEVER_MAX)
             if rank == (False, False):
                 return
             if best is None or rank < best[0]:
@@ -315,7 +316,7 @@ class ScriptedOperator:
         executed = self._events_since(k, "grasp_executed")
         if executed:
             chosen = np.asarray(executed[-1]["grasp"]["position"])
-            rec.lever = round(lever(np.asarray(executed[-1]["grasp"]["pose"]), centre), 4)
+            rec.lever = round(hold_lever(np.asarray(executed[-1]["grasp"]["pose"]), centre), 4)
             closed = executed[-1].get("closed_width")
             if closed is not None:
                 rec.grip = (executed[-1]["grasp"]["width"], closed)
@@ -410,17 +411,6 @@ def seen_middle(points: np.ndarray) -> np.ndarray:
     visible extent, not its centre of mass, which no one sees."""
     pts = np.asarray(points, dtype=float)
     return (pts.min(axis=0) + pts.max(axis=0)) / 2
-
-
-def lever(pose: np.ndarray, centre: np.ndarray) -> float:
-    """How far (m) a grasp at `pose` (4 x 4 TCP pose, `base`) holds an object off its centre
-    of mass `centre` (m, `base`), as gravity sees it: the lever arm of the object's weight
-    about the line between the fingers, about which it turns in the pads. With c the
-    closing axis and d the centre's offset from the TCP, the weight's torque about c is
-    m g (c_x d_y - c_y d_x): the level distance from the centre to the upright plane through
-    that line when the fingers close level, and none when they close straight up and down."""
-    c, d = pose[:3, 1], centre - pose[:3, 3]
-    return abs(float(c[0] * d[1] - c[1] * d[0]))
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from laserpick.description.dims import GRIPPER_HAND
+from laserpick.pipeline.balance import holds_across_middle
 from laserpick.settings import GraspSettings, get_settings
 from laserpick.types import Grasp, GraspScores
 
@@ -120,15 +121,21 @@ class GraspClusters:
         return self.grasps[self.clusters[0][0]] if self.clusters else None
 
 
-def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> GraspClusters:
+def group(
+    grasps: Sequence[Grasp],
+    settings: GraspSettings | None = None,
+    middle: np.ndarray | None = None,
+) -> GraspClusters:
     """Cluster grasps by position (004 section 7.2) and order everything by score, those
-    whose pads meet the object about their middle first (`Grasp.pads_centred`): the grasps
-    in each cluster, and the clusters by their first grasp.
+    whose pads meet the object about their middle first (`Grasp.pads_centred`), and among
+    them those that hold the object across its `middle` (m, `base`; `holds_across_middle`):
+    the grasps in each cluster, and the clusters by their first grasp.
 
     Ours: 004 orders by score alone. But C does not see where along the pads the object
-    lies, and a can met only toward the pads' edges spins out of the hand when the scooter
-    turns. Such a grasp is still offered, after the others:
-    it is often the only one an object has."""
+    lies, nor where along the object the hand holds it: a can met only toward the pads'
+    edges spins out of the hand when the scooter turns, and a remote held near one end
+    turns in the pads and falls. Such grasps are still offered, after the others: they are
+    often the only ones an object has."""
     s = settings or get_settings().grasp
     if not grasps:
         return GraspClusters((), ())
@@ -137,8 +144,10 @@ def group(grasps: Sequence[Grasp], settings: GraspSettings | None = None) -> Gra
     for i, label in enumerate(labels):
         members.setdefault(int(label), []).append(i)
 
-    def rank(i: int) -> tuple[bool, float]:
-        return not grasps[i].pads_centred, -grasps[i].score
+    def rank(i: int) -> tuple[bool, bool, float]:
+        g = grasps[i]
+        across = holds_across_middle(g.pose, middle, s.balance_lever)
+        return not g.pads_centred, not across, -g.score
 
     ordered = [sorted(m, key=rank) for m in members.values()]
     ordered.sort(key=lambda m: rank(m[0]))

@@ -69,6 +69,15 @@ class GraspSettings(BaseModel):
     gpd_finger_placements: int = Field(
         10, ge=1, description="Lateral hand offsets along the closing axis per rotation. GPD."
     )
+    balance_lever: float = Field(
+        0.02,
+        ge=0,
+        description="Farthest (m) a grasp may hold the object's seen middle from the line"
+        " between its fingers, as gravity sees it (`pipeline.balance`), and still count as"
+        " across the middle: grasps farther off are offered after the others, and where GPD's"
+        " reachable grasps are all farther off, its pass on the target completed by symmetry"
+        " runs too. A person holds a remote across its middle. 0 turns it off. Ours.",
+    )
     gpd_tilts_deg: tuple[float, ...] = Field(
         (-60.0, -30.0, 30.0, 60.0),
         description="Tilts (deg) of the hand about its closing axis, leaning the approach toward"
