@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from table_clouds import table_perception
 
 from laserpick.description import dims
 from laserpick.pipeline.balance import hold_lever, holds_across_middle
@@ -15,7 +16,7 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.selection import group
 from laserpick.settings import Settings
-from laserpick.types import FusedCloud, Grasp, GraspScores, LaserMark, Segmentation, SupportSurface
+from laserpick.types import Grasp, GraspScores
 
 TABLE = 0.31  #: m, the kitchen's low table
 SPACING = 0.003  #: m between the synthetic cloud's points
@@ -84,19 +85,13 @@ def _remote_seen_from_the_left(centre: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _remote_perception(centre: np.ndarray) -> Perception:
     obj, obj_n = _remote_seen_from_the_left(centre)
-    g = np.arange(-0.3, 0.3, 0.006)
-    x, y = np.meshgrid(g, g)
-    table = np.column_stack([x.ravel() + centre[0], y.ravel() + centre[1], np.full(x.size, TABLE)])
-    under = np.all(np.abs(table[:, :2] - centre) < REMOTE[:2] / 2 + 0.005, axis=1)
-    table = table[~under]
-    pts = np.vstack([obj, table]).astype(np.float32)
-    normals = np.vstack([obj_n, np.tile([0.0, 0.0, 1.0], (len(table), 1))]).astype(np.float32)
-    n = len(pts)
-    cloud = FusedCloud(pts, normals, np.zeros(n, np.uint8), np.arange(n, dtype=np.int32), ("c",))
-    surface = SupportSurface(TABLE, np.array([0.0, 0.0, 1.0, -TABLE]))
-    seg = Segmentation(np.arange(len(obj)), "cluster", surface)
-    top = np.array([centre[0], centre[1], TABLE + REMOTE[2]])
-    return Perception(cloud, LaserMark(top, "confirmed", 0, "direct"), seg, None)
+    return table_perception(
+        obj,
+        obj_n,
+        centre,
+        TABLE,
+        lambda xy: np.all(np.abs(xy - centre) < REMOTE[:2] / 2 + 0.005, axis=1),
+    )
 
 
 def test_a_remote_seen_across_only_at_its_end_is_offered_a_grasp_across_its_middle() -> None:

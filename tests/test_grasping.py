@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from table_clouds import table_perception
 
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
@@ -13,7 +14,7 @@ from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.strategies import vertical_grasp
 from laserpick.settings import get_settings
-from laserpick.types import FusedCloud, Grasp, LaserMark, Segmentation, SupportSurface
+from laserpick.types import Grasp
 
 TABLE = 0.46
 SPACING = 0.003
@@ -52,19 +53,11 @@ def _box_front_left_top(centre, size=(0.06, 0.05, 0.20)):
 
 def _perception(centre, shape=_cylinder, **kw) -> Perception:
     """An object (a cylinder) on a table, segmented, marked at its top."""
-    obj, obj_n = shape(np.asarray(centre), **kw)
-    g = np.arange(-0.3, 0.3, 0.006)
-    x, y = np.meshgrid(g, g)
-    table = np.column_stack([x.ravel() + centre[0], y.ravel() + centre[1], np.full(x.size, TABLE)])
-    table = table[np.linalg.norm(table[:, :2] - centre, axis=1) > 0.035]
-    pts = np.vstack([obj, table]).astype(np.float32)
-    normals = np.vstack([obj_n, np.tile([0.0, 0.0, 1.0], (len(table), 1))]).astype(np.float32)
-    n = len(pts)
-    cloud = FusedCloud(pts, normals, np.zeros(n, np.uint8), np.arange(n, dtype=np.int32), ("c",))
-    surface = SupportSurface(TABLE, np.array([0.0, 0.0, 1.0, -TABLE]))
-    seg = Segmentation(np.arange(len(obj)), "cluster", surface)
-    top = np.array([centre[0], centre[1], obj[:, 2].max()])
-    return Perception(cloud, LaserMark(top, "confirmed", 0, "direct"), seg, None)
+    centre = np.asarray(centre)
+    obj, obj_n = shape(centre, **kw)
+    return table_perception(
+        obj, obj_n, centre, TABLE, lambda xy: np.linalg.norm(xy - centre, axis=1) <= 0.035
+    )
 
 
 @pytest.mark.parametrize("strategy", ["gpd", "vertical", "overhead"])
