@@ -81,8 +81,8 @@ class GraspSet:
     def carried(self) -> np.ndarray:
         """The points (m, `base`) that stand for the target in the hand (`carried_shape`):
         worked out once, for the planner's lift and for the pick (5-12 ms)."""
-        if not len(self.cut_off) and self.as_seen is not None:
-            return self.as_seen
+        if not len(self.cut_off):
+            return self.carried_as_seen
         return carried_shape(np.vstack([self.target, self.cut_off]), self.stands_on)
 
     @functools.cached_property
@@ -92,8 +92,6 @@ class GraspSet:
         worked out twice then."""
         if self.as_seen is not None:
             return self.as_seen
-        if not len(self.cut_off):
-            return self.carried
         return carried_shape(self.target, self.stands_on)
 
     @functools.cached_property
