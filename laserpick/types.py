@@ -69,11 +69,15 @@ class Failure:
     back_up: how far (m) the scooter should back up, straight, for the arm to do what it
     could not from where it stands, when the robot worked that out (the sentence says so
     too); None otherwise.
+    park_left: how far (m) to its left (negative: its right) the scooter should park for
+    its cameras to see the way the arm needs, when the robot worked that out (the sentence
+    says so too); None otherwise.
     """
 
     kind: FailureKind
     message: str
     back_up: float | None = None
+    park_left: float | None = None
 
     def __str__(self) -> str:
         return self.message

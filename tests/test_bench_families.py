@@ -12,6 +12,7 @@ from typing import Any
 from laserpick.bench.families import family_of, format_sweep, load_sweep, surface_kind
 
 NO_POSTURE = "The arm cannot take any of {n} grasps (every arm posture for this grasp collides)."
+UNSEEN = "None of the 2 grasps could be planned (no way). Park about 20 cm farther to your right."
 GLASS = "I see no object at the mark, only the surface: a clear glass does not show."
 
 
@@ -53,6 +54,8 @@ def test_losses_that_differ_only_in_numbers_and_names_are_one_family(tmp_path: P
         [
             _record(0, 1, "pill_bottle", NO_POSTURE.format(n=12)),  # lost for good
             _record(0, 2, "mug"),
+            _record(0, 3, "juice_bottle", UNSEEN, parked_aside=-0.2),  # lost after re-parking
+            _record(0, 3, "juice_bottle"),  # done at the second try
         ],
     )
     sweep = load_sweep([a, b])
@@ -61,13 +64,15 @@ def test_losses_that_differ_only_in_numbers_and_names_are_one_family(tmp_path: P
     assert posture.key == family_of(sweep.tasks[("pick-place seed 200", 0, "auto", 1)][0])
     assert posture.key.surface == "bookshelf" and "any of N grasps" in posture.key.sentence
     assert (posture.attempts, posture.tasks_lost, posture.recovered) == (2, 1, 1)
-    assert [f.key.kind for f in families] == ["ik_plan", "precondition"]
-    assert sweep.task_rates() == (5, 3, 2)  # 5 tasks, 3 done, 2 at the first try
-    assert sweep.task_rates(["glass_cup"]) == (4, 3, 2)
+    assert [f.key.kind for f in families] == ["ik_plan", "precondition", "ik_plan"]
+    assert sweep.task_rates() == (6, 4, 2)  # 6 tasks, 4 done, 2 at the first try
+    assert sweep.task_rates(["glass_cup"]) == (5, 4, 2)
     text = format_sweep(sweep, ["glass_cup"])
-    assert "| without glass_cup | 4 | 3 (75.0 %) | 2 (50.0 %) |" in text
-    assert sweep.backed_up() == (1, 1)
+    assert "| without glass_cup | 5 | 4 (80.0 %) | 2 (40.0 %) |" in text
+    assert sweep.moved_as_asked("backed_up") == (1, 1)
+    assert sweep.moved_as_asked("parked_aside") == (1, 0)
     assert "backed up as the robot asked, before the arm moved: 1 (1 of them done)" in text
+    assert "parked to a side as it asked, for its cameras to see the way: 1 (0 of them" in text
 
 
 def test_a_surface_kind_drops_its_number() -> None:

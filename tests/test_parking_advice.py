@@ -13,7 +13,14 @@ from laserpick.bench.protocols import PROTOCOLS, Options
 from laserpick.description.dims import ARM_MOUNT_POS, UR5_READY_Q
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.grasp_choice import unreachable
-from laserpick.pipeline.parking_advice import BACK_UP_STEPS, back_up_advice, backed_up_grasps
+from laserpick.pipeline.parking_advice import (
+    ASIDE_STEP,
+    BACK_UP_STEPS,
+    IN_VIEW_Y,
+    back_up_advice,
+    backed_up_grasps,
+    park_aside_advice,
+)
 from laserpick.pipeline.reach import reachable
 from laserpick.settings import get_settings
 from laserpick.types import Grasp
@@ -117,3 +124,14 @@ def test_the_user_backs_up_as_asked_and_the_first_try_takes_the_object(tmp_path:
     assert rec.success, rec.message
     assert rec.backed_up in BACK_UP_STEPS
     assert rec.marks >= 2  # the mark the robot answered with its advice, and the one after
+
+
+def test_parking_aside_brings_the_object_nearer_the_middle_of_the_cameras_view() -> None:
+    """Straight before the arm (its mount's y) the object is asked to be moved left of it,
+    toward IN_VIEW_Y, the scooter parking right; left of that, the other way; within half
+    a step of it, not at all."""
+    assert park_aside_advice(np.array([1.5, ARM_MOUNT_POS[1], 1.1])) == -ASIDE_STEP
+    assert park_aside_advice(np.array([1.5, -0.9, 1.1])) == -ASIDE_STEP
+    assert park_aside_advice(np.array([1.5, IN_VIEW_Y + 0.15, 1.1])) == ASIDE_STEP
+    assert park_aside_advice(np.array([1.5, IN_VIEW_Y - ASIDE_STEP / 3, 1.1])) is None
+    assert park_aside_advice(np.array([1.5, np.nan, 1.1])) is None

@@ -17,9 +17,10 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
-from laserpick.pipeline.first_plan import UNSEEN_WAYS, plan_first
+from laserpick.pipeline.first_plan import UNSEEN_WAYS, park_aside_sentence, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches, joint_path
+from laserpick.pipeline.parking_advice import ASIDE_STEP
 from laserpick.pipeline.plan import plan_pick, transit_path
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot
@@ -224,7 +225,9 @@ def test_a_leg_kept_from_unseen_space_says_a_way_led_through_it(world):
 
 def test_a_pick_whose_ways_all_pass_unseen_space_says_so(world):
     """Planned from ready, a grasp beside the table fails for want of a way through seen
-    space, and the failure says that ways through unseen space were left untaken."""
+    space, and the failure says that ways through unseen space were left untaken, and asks
+    the user to park to their right, with the object
+    nearer the middle of the cameras' view."""
     s = get_settings().motion.model_copy(update={"rrt_max_samples": 300})
     pose = tcp_pose(READY)
     pose[:3, 3] = 1.40, -0.75, 0.80
@@ -235,3 +238,6 @@ def test_a_pick_whose_ways_all_pass_unseen_space_says_so(world):
     assert isinstance(plan, Failure) and chosen is None and tried == 1
     assert plan.message.startswith("No collision-free path to this grasp was found")
     assert plan.message.endswith(UNSEEN_WAYS)
+    assert plan.park_left == -ASIDE_STEP
+    asked = park_aside_sentence(plan.park_left)
+    assert asked.startswith(f" Park about {ASIDE_STEP * 100:.0f} cm farther to your right")

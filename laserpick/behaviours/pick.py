@@ -20,7 +20,7 @@ from laserpick.behaviours.messages import NO_BASKET_HOLD
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.first_plan import plan_first
+from laserpick.pipeline.first_plan import park_aside_sentence, plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
@@ -55,7 +55,10 @@ class Picking(Withdrawing):
         timings = {"plan": time.perf_counter() - t0}
         if isinstance(plan, Failure):
             msg = f"None of the {attempts} grasps could be planned ({plan.message})"
-            return Outcome(Failure("ik_plan", msg), attempts=attempts, timings=timings)
+            if plan.park_left is not None:
+                msg += "." + park_aside_sentence(plan.park_left)
+            failure = Failure("ik_plan", msg, park_left=plan.park_left)
+            return Outcome(failure, attempts=attempts, timings=timings)
         self.progress(f"Grasp {attempts} of {len(order)} planned; moving to it.")
         # The carry's search reads only the plan and what the cameras saw: started now, it
         # runs while the arm moves in, not only while it lifts (`isolation`: the arm stood

@@ -37,6 +37,10 @@ class Attempt:
     #: m the user backed the scooter up within this try, as the robot asked before the arm
     #: moved (`Failure.back_up`), and marked again from there
     backed_up: float = 0.0
+    #: m the user re-parked to the scooter's left (negative: right) within this try, as the
+    #: robot asked after its planning found only ways its cameras did not see
+    #: (`Failure.park_left`), and marked again from there
+    parked_aside: float = 0.0
     places: int = 0  #: place marks confirmed (pick and place)
     detected: bool = False  #: the grasp chosen (or executed) was on the marked object
     #: the marked object was lifted and held (in pick-and-drop: and landed in the basket)

@@ -68,9 +68,10 @@ class Sweep:
         first = sum(bool(a[0]["success"]) for a in kept)
         return len(kept), done, first
 
-    def backed_up(self) -> tuple[int, int]:
-        """(tries in which the user backed up as the robot asked, those of them done)."""
-        tries = [r for a in self.tasks.values() for r in a if r.get("backed_up", 0.0) > 0.0]
+    def moved_as_asked(self, field: str) -> tuple[int, int]:
+        """(tries in which the user moved the scooter as the robot asked, the attempt's
+        `field` non-zero: "backed_up", "parked_aside"; those of them done)."""
+        tries = [r for a in self.tasks.values() for r in a if r.get(field, 0.0) != 0.0]
         return len(tries), sum(bool(r["success"]) for r in tries)
 
     def families(self) -> list[Family]:
@@ -155,11 +156,13 @@ def format_sweep(sweep: Sweep, leave_out: Sequence[str] = ()) -> str:
     ]
     if leave_out:
         lines.append(_rate_line(f"without {', '.join(leave_out)}", sweep.task_rates(leave_out)))
-    backed, backed_done = sweep.backed_up()
+    backed, backed_done = sweep.moved_as_asked("backed_up")
+    aside, aside_done = sweep.moved_as_asked("parked_aside")
     lines += [
         "",
         f"Tries in which the user backed up as the robot asked, before the arm moved: {backed}"
-        f" ({backed_done} of them done).",
+        f" ({backed_done} of them done); parked to a side as it asked, for its cameras to see"
+        f" the way: {aside} ({aside_done} of them done).",
         "",
         "| failure | what the robot said | on | attempts lost | tasks lost | first tries"
         " a later try recovered | e.g. |",

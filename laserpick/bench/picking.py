@@ -121,6 +121,9 @@ class ScriptedOperator:
         #: the task, and whether they parked there: the protocols that drive set it for each
         #: task (None: the user stays where they are).
         self.back_up: Callable[[float], bool] | None = None
+        #: How the user parks so many m to the scooter's left (negative: right) of where they
+        #: parked for the task, and whether they parked there (set as `back_up` is).
+        self.park_left: Callable[[float], bool] | None = None
         self._events: list[dict[str, Any]] = []
         # Stamped with the simulated time as they happen (listeners run on the emitting thread).
         session.on_event(lambda e: self._events.append({**e, "sim_time": self._sim_time()}))
@@ -308,6 +311,8 @@ class ScriptedOperator:
         t_sim = self._sim_time()
         s.execute(BENCH)
         self.wait()
+        if self._parks_aside(rec):
+            return self._pick_from_aside(rec, aim, stage_timings(self._events_since(k, "job")))
         released = self._released_at(k)
         execute_sim = (self._sim_time() if released is None else released) - t_sim
         done = self._events_since(k, "job")
@@ -330,6 +335,33 @@ class ScriptedOperator:
         elif s.failure is not None:
             rec.fail(s.failure.kind, s.failure.message)
         return rec.grasped and rec.detected
+
+    def _parks_aside(self, rec: Attempt) -> bool:
+        """Whether the user re-parks to a side and tries again within `rec`: the robot said,
+        before the arm moved, where to park for its cameras to see the way it needs
+        (`Failure.park_left`), and the user has not re-parked within this try yet."""
+        failure = self.session.failure
+        asked = None if failure is None else failure.park_left
+        return asked is not None and not rec.parked_aside and self.park_left is not None
+
+    def _pick_from_aside(
+        self, rec: Attempt, aim: np.ndarray | None, spent: dict[str, float]
+    ) -> bool:
+        """Park where the robot asked (`_parks_aside`), once a try, as a person told so would,
+        and mark, choose and pick again from there (`pick`). The seconds the try spent
+        before (`spent`, per stage: its planning, mostly) stay in `rec`'s timings."""
+        failure, s = self.session.failure, self.session
+        assert failure is not None and failure.park_left is not None and self.park_left
+        s.cancel(BENCH)
+        rec.parked_aside = failure.park_left
+        if not self.park_left(failure.park_left):
+            rec.timings = spent
+            rec.fail(failure.kind, failure.message)
+            return False
+        lifted = self.pick(rec, aim)
+        for stage, seconds in spent.items():
+            rec.timings[stage] = rec.timings.get(stage, 0.0) + seconds
+        return lifted
 
     def _released_at(self, k: int) -> float | None:
         """Simulated time (s) the job begun at event `k` let go of the object (dropped or set

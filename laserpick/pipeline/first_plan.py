@@ -20,6 +20,7 @@ from laserpick.description.dims import (
 )
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
+from laserpick.pipeline.parking_advice import park_aside_advice
 from laserpick.pipeline.pick_prep import PickPrep, prepare_pick
 from laserpick.pipeline.plan import NO_WAY, PickPlan, transit_path, transit_to_any, way_to
 from laserpick.settings import MotionSettings, get_settings
@@ -31,7 +32,9 @@ __all__ = [
     "UNSEEN_WAYS",
     "at_pose",
     "at_rest",
+    "park_aside_sentence",
     "plan_first",
+    "unseen_ways_failure",
 ]
 
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
@@ -125,8 +128,27 @@ def plan_first(
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
     if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
-        plan = Failure("ik_plan", f"{plan.message.rstrip('.')}{UNSEEN_WAYS}")
+        plan = unseen_ways_failure(plan, found.middle)
     return plan, None, first.tried
+
+
+def unseen_ways_failure(failure: Failure, middle: np.ndarray) -> Failure:
+    """`failure` (no way found) said again with why (`UNSEEN_WAYS`), carrying how far to
+    park to a side for the object, whose middle is at `middle` (m, `base`), to stand nearer
+    the middle of the cameras' view (`park_aside_advice`, `Failure.park_left`; the pick says
+    it with `park_aside_sentence`)."""
+    msg = f"{failure.message.rstrip('.')}{UNSEEN_WAYS}"
+    return Failure("ik_plan", msg, park_left=park_aside_advice(middle))
+
+
+def park_aside_sentence(left: float) -> str:
+    """What the robot asks where it would have the scooter park `left` m to its left
+    (negative: right): a sentence to follow the failure's."""
+    side = "left" if left > 0 else "right"
+    return (
+        f" Park about {round(abs(left) * 100)} cm farther to your {side} and mark it again:"
+        " there it stands nearer the middle of the cameras' view."
+    )
 
 
 def _place(grasps: Sequence[Grasp], grasp: Grasp) -> int:

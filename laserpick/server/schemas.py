@@ -233,6 +233,9 @@ class FailureStatus(BaseModel):
     #: How far (m) to back the scooter up, straight, for the arm to do it; null when the
     #: robot has no such advice.
     back_up: float | None = None
+    #: How far (m) to park the scooter to its left (negative: right) for the cameras to see
+    #: the way the arm needs; null when the robot has no such advice.
+    park_left: float | None = None
 
 
 class Status(BaseModel):

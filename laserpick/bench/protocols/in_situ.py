@@ -26,7 +26,7 @@ def in_situ(trial: int, seed: int, opt: Options) -> list[Attempt]:
         names = shuffled(op, instances(scene))[:IN_SITU_OBJECTS]
         for task, name in enumerate(limit(names, opt)):
             spot = TaskSpot(op, scene, name)
-            op.back_up = spot.back_up
+            op.back_up, op.park_left = spot.back_up, spot.park_left
             parked = spot.go()
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)

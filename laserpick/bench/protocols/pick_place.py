@@ -51,7 +51,7 @@ def pick_place(trial: int, seed: int, opt: Options) -> list[Attempt]:
         for task, name in enumerate(limit(shuffled(op, instances(scene)), opt)):
             op.begin_task(task)
             spot = TaskSpot(op, scene, name)
-            op.back_up = spot.back_up
+            op.back_up, op.park_left = spot.back_up, spot.park_left
             for _ in range(MAX_TRIES):
                 rec = op.new_attempt(name, opt.selection, opt.strategy)
                 rec.task = task

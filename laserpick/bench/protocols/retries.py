@@ -10,7 +10,6 @@ import numpy as np
 from laserpick.bench.attempts import Attempt
 from laserpick.bench.parking import go_to_object
 from laserpick.bench.picking import ScriptedOperator
-from laserpick.pipeline.first_plan import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import Scene
 
 #: Tries per object in the in-situ and pick-place protocols (004 section 8.2 retried until
@@ -24,27 +23,15 @@ STILL_THERE = (0.05, 0.02)
 #: ik_plan failure), as a person told that the arm cannot reach moves the scooter: under a
 #: shelf's board the arm needs room to come in level.
 RETRY_BACK = 0.10
-#: m to the left of straight before the arm that the user parks an object on a table instead,
-#: for the try after the arm said its only ways passed where the cameras could not see:
-#: nearer the middle of their view, as a person told so moves the scooter. Beside the arm,
-#: above the right-hand cameras' upper edge, no camera looks (on the 108 cm table every way
-#: up to an object there crosses x 1.25-1.74 m, z 1.02-1.41 m in `base`, unseen). Farther
-#: back does not help there: the high camera's upper edge falls as it looks farther. At a
-#: shelf the user still backs off, for the board.
-IN_VIEW_ACROSS = 0.20
 
 
-def next_try(rec: Attempt, back: float, across: float, scene: Scene) -> tuple[float, float]:
+def next_try(rec: Attempt, back: float, across: float) -> tuple[float, float]:
     """Where the user parks for the next try after `rec` (back, across: m, as in
-    `go_to_object`): where the arm could not take the object, farther back (RETRY_BACK),
-    or, where it stands on a table or a counter (not a shelf, as `scene` placed it) and the
-    arm said that only unseen space kept it from the object, first with it nearer the
-    middle of the cameras' view (IN_VIEW_ACROSS)."""
+    `go_to_object`): where the arm could not take the object, farther back (RETRY_BACK).
+    Where the robot asked to park to a side, the user did so within the try
+    (`TaskSpot.park_left`)."""
     if rec.failure != "ik_plan":
         return back, across
-    shelf = scene.surface(scene.placement(rec.instance).surface).kind == "shelf"
-    if not shelf and UNSEEN_WAYS in (rec.message or "") and across == 0.0:
-        return back, IN_VIEW_ACROSS
     return back + RETRY_BACK, across
 
 
@@ -69,9 +56,16 @@ class TaskSpot:
         self.back += distance
         return self.go()
 
+    def park_left(self, distance: float) -> bool:
+        """Park `distance` m farther to the scooter's left (negative: right), as the robot
+        asked: the object then lies that much farther to the arm's right. Whether the user
+        parked."""
+        self.across -= distance
+        return self.go()
+
     def after(self, rec: Attempt) -> None:
         """Where the next try parks after `rec` (`next_try`)."""
-        self.back, self.across = next_try(rec, self.back, self.across, self.scene)
+        self.back, self.across = next_try(rec, self.back, self.across)
 
 
 def still_there(op: ScriptedOperator, name: str, stood: np.ndarray) -> bool:

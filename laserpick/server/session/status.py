@@ -116,7 +116,10 @@ class StatusReads(SessionCore):
                 failure=None
                 if failure is None
                 else schemas.FailureStatus(
-                    kind=failure.kind, message=failure.message, back_up=failure.back_up
+                    kind=failure.kind,
+                    message=failure.message,
+                    back_up=failure.back_up,
+                    park_left=failure.park_left,
                 ),
                 lease=schemas.LeaseStatus(
                     held=lease.held, holder=lease.holder, source=lease.source
