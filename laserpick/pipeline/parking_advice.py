@@ -55,9 +55,10 @@ IN_VIEW_Y = -0.10
 #: m the robot asks the user to park aside, toward IN_VIEW_Y: on the kitchen's 108 cm table
 #: the first try at a juice bottle straight before the arm found only ways through unseen
 #: space on 10 of 20 sweep seeds; the next try, parked 20 cm to the arm's left, took it on
-#: 6 of them, the one after (10 cm farther back too) on 3 more. Not worked out from the way: the blind points lie where the cameras' rays
-#: read nothing in range, and which of them a re-park brings into view, no frustum tells
-#: (15 and 25 cm re-parks failed where 20 cm served, on one traced juice bottle).
+#: 6 of them, the one after (10 cm farther back too) on 3 more. Not worked out from the
+#: way: the blind points lie where the cameras' rays read nothing in range, and which of
+#: them a re-park brings into view, no frustum tells (15 and 25 cm re-parks failed where
+#: 20 cm served, on one traced juice bottle).
 ASIDE_STEP = 0.20
 
 
