@@ -151,8 +151,8 @@ def test_after_the_arm_could_not_take_the_object_the_user_parks_farther_back():
 
 def test_where_the_spot_asked_is_not_clear_the_user_parks_as_near_it_as_the_room_allows():
     """With the arm standing by beside the scooter (its outline 10 cm wider on the right than
-    stowed), the spot 20 cm to the arm's left before the 108 cm table, asked for a second
-    try, brings the scooter's right side against the furniture beside it. The user parks
+    stowed), the spot 20 cm to the arm's left before the 108 cm table, as the robot asks
+    for one, brings the scooter's right side against the furniture beside it. The user parks
     at the nearest spot that is clear instead: 10 cm across. Stowed, the spot asked is."""
     kitchen = load_scene("kitchen", seed=1)
     table = kitchen.surface("high_table")

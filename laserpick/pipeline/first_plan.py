@@ -34,7 +34,6 @@ __all__ = [
     "at_rest",
     "park_aside_sentence",
     "plan_first",
-    "unseen_ways_failure",
 ]
 
 READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
@@ -128,11 +127,11 @@ def plan_first(
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
     if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
-        plan = unseen_ways_failure(plan, found.middle)
+        plan = _unseen_ways_failure(plan, found.middle)
     return plan, None, first.tried
 
 
-def unseen_ways_failure(failure: Failure, middle: np.ndarray) -> Failure:
+def _unseen_ways_failure(failure: Failure, middle: np.ndarray) -> Failure:
     """`failure` (no way found) said again with why (`UNSEEN_WAYS`), carrying how far to
     park to a side for the object, whose middle is at `middle` (m, `base`), to stand nearer
     the middle of the cameras' view (`park_aside_advice`, `Failure.park_left`; the pick says
