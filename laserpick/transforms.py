@@ -91,6 +91,16 @@ def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
     return float(math.acos(max(-1.0, min(1.0, c))))
 
 
+def rotation_angles(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
+    """Angles (rad) of the rotations taking R0 to R1 (..., 3, 3), by arctan2: exact near
+    no turn and half a turn alike."""
+    M = np.swapaxes(R0, -1, -2) @ R1
+    skew = M - np.swapaxes(M, -1, -2)
+    sin2 = np.linalg.norm(skew[..., [2, 0, 1], [1, 2, 0]], axis=-1)  # 2 sin(angle)
+    cos2 = np.trace(M, axis1=-2, axis2=-1) - 1.0  # 2 cos(angle)
+    return np.arctan2(sin2, cos2)
+
+
 def turn_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The rotation (3, 3) taking unit vector `a` onto unit vector `b` the shortest way
     (Rodrigues); half a turn about an axis across `a` where they point opposite ways."""

@@ -4,9 +4,10 @@ joint speed, joint acceleration, joint jerk and TCP speed limits.
 1. The polyline's corners are blended (`smoothing.corners`): the path is C2. A corner whose
    blend would be too tight to take at STOP_SPEED is not: the arm comes to rest there, and
    each part between such corners is timed alone.
-2. TOPP-RA (Pham and Pham 2018, the `toppra` package) finds the fastest path velocity
-   profile under the joint speed and acceleration limits and the TCP speed cap, the arm at
-   rest at both ends. Its path acceleration is constant between grid points and jumps at them.
+2. TOPP-RA (Pham and Pham 2018, the `toppra` package; `toppra_path`) finds the fastest
+   path velocity profile under the joint speed and acceleration limits and the TCP speed
+   cap, the arm at rest at both ends. Its path acceleration is constant between grid points
+   and jumps at them.
 3. The profile is smoothed in time: s_f(t) is the mean of s over [t - tau, t]. Its path
    velocity is (s(t) - s(t - tau)) / tau, its acceleration the mean of TOPP-RA's, so
    continuous, and its jerk the change of TOPP-RA's acceleration over tau, divided by tau:
@@ -17,49 +18,36 @@ joint speed, joint acceleration, joint jerk and TCP speed limits.
    before and after: joint speed, acceleration and jerk and the TCP's speed. Where the
    smoothing overshot (it lets the arm round a corner a little faster than TOPP-RA did), the
    path velocity is capped around the samples that were over, and TOPP-RA runs again; where
-   the jerk was over, tau is widened (up to TAU_MAX times). After PASSES tries, what is left
-   over is taken out by slowing the whole part uniformly in time (speed scales with 1/k,
-   acceleration with 1/k^2, jerk with 1/k^3), checked again on the new samples until they
-   keep every limit.
+   only the jerk was over, tau is widened (up to TAU_MAX times) and the profile kept. After
+   PASSES tries, what is left over is taken out by slowing the whole part uniformly in time
+   (speed scales with 1/k, acceleration with 1/k^2, jerk with 1/k^3), checked again on the
+   new samples until they keep every limit.
 
 Units: rad, s, m; TCP positions in `base`.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import toppra
-import toppra.algorithm
-import toppra.constraint
 
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.smoothing import BlendedPath, ClearFn, corners
+from laserpick.pipeline.toppra_path import GRID_STEP, INSIDE, FastestProfile, path_grid
+from laserpick.transforms import rotation_angles
 from laserpick.types import GripperEvent, Trajectory
 
 __all__ = ["Limits", "excess", "straight_times", "time_parametrize"]
 
-#: TOPP-RA's grid: at most this far apart (rad of path), and at least this many intervals
-#: in every piece of the path (a blend's curvature changes within it).
-GRID_STEP = 0.02
-GRID_PER_PIECE = 4
 #: Checks and corrections of the sampled trajectory before the last, uniform slow-down.
 PASSES = 4
 #: Corrections aim this far under the limits, so that sampling does not put them back over.
 MARGIN = 1.002
-#: TOPP-RA and the smoothing aim this much inside the limits, so that a profile at a limit
-#: is not taken for one over it by rounding.
-INSIDE = 1.0 - 1e-6
-#: Step (rad) of the finite difference that gives the TCP's speed along the path.
-_EPS = 1e-6
-#: Path velocity caps (rad of path per s): none is lower (the arm would barely move), none
-#: higher (TOPP-RA's bounds are squared).
+#: The lowest path velocity cap (rad of path per s): the arm would barely move.
 MIN_CAP = 1e-3
-LARGE = 1e3
 #: A corner whose blend the arm could take no faster than this (rad of path per s) is not
 #: blended: the arm stops there (a tight blend would take as long).
 STOP_SPEED = 0.05
@@ -91,34 +79,6 @@ class Limits:
             raise ValueError("the hand's turning speed cap must be positive")
 
 
-class _Path(toppra.interpolator.AbstractGeometricPath):
-    """A `BlendedPath` as TOPP-RA reads a path."""
-
-    def __init__(self, path: BlendedPath) -> None:
-        self._path = path
-        self._interval = np.array([0.0, path.length])
-
-    def __call__(self, path_positions, order: int = 0) -> np.ndarray:
-        return self._path(path_positions, order)
-
-    @property
-    def dof(self) -> int:
-        return 6
-
-    @property
-    def path_interval(self) -> np.ndarray:
-        return self._interval
-
-
-def _turn_angles(R0: np.ndarray, R1: np.ndarray) -> np.ndarray:
-    """The angles (rad) of the turns from rotations R0 to R1 (..., 3, 3)."""
-    M = np.swapaxes(R0, -1, -2) @ R1
-    skew = M - np.swapaxes(M, -1, -2)
-    sin2 = np.linalg.norm(skew[..., [2, 0, 1], [1, 2, 0]], axis=-1)  # 2 sin(angle)
-    cos2 = np.trace(M, axis1=-2, axis2=-1) - 1.0  # 2 cos(angle)
-    return np.arctan2(sin2, cos2)
-
-
 def straight_times(a: np.ndarray, b: np.ndarray, limits: Limits, samples: int = 6) -> np.ndarray:
     """(B,) the least time (s) each straight joint move from a (B, 6) to b (B, 6) (rad)
     takes at the speed limits, its accelerations left out: the largest joint's motion at
@@ -134,69 +94,9 @@ def straight_times(a: np.ndarray, b: np.ndarray, limits: Limits, samples: int = 
         arc = np.linalg.norm(np.diff(T[:, :, :3, 3], axis=1), axis=2).sum(axis=1)
         times.append(arc / limits.tcp_speed)
     if limits.turn_speed is not None:
-        turn = _turn_angles(T[:, :-1, :3, :3], T[:, 1:, :3, :3]).sum(axis=1)
+        turn = rotation_angles(T[:, :-1, :3, :3], T[:, 1:, :3, :3]).sum(axis=1)
         times.append(turn / limits.turn_speed)
     return np.maximum.reduce(times)
-
-
-class _SpeedBound(toppra.constraint.LinearConstraint):
-    """Bounds on sd^2 at each grid point: the TCP's speed |dp/ds| sd <= tcp_speed and the
-    hand's turning speed |dR/ds| sd <= turn_speed (None: no cap), and sd <= caps (N,), the
-    grid's own caps."""
-
-    def __init__(self, limits: Limits, caps: np.ndarray) -> None:
-        super().__init__()
-        self.limits = limits
-        self.caps = caps
-        self.dof = 6
-
-    def compute_constraint_params(self, path, gridpoints):
-        xbound = np.zeros((len(gridpoints), 2))
-        xbound[:, 1] = np.minimum(self.caps, LARGE) ** 2
-        tcp_speed, turn_speed = self.limits.tcp_speed, self.limits.turn_speed
-        if tcp_speed is None and turn_speed is None:
-            return None, None, None, None, None, None, xbound
-        q, dq = path(gridpoints, 0), path(gridpoints, 1)
-        ahead, behind = tcp_pose(q + _EPS * dq), tcp_pose(q - _EPS * dq)
-        rates = []  # (limit, its unit per rad of path)
-        if tcp_speed is not None:
-            step = np.linalg.norm(ahead[:, :3, 3] - behind[:, :3, 3], axis=1)
-            rates.append((tcp_speed, step / (2 * _EPS)))
-        if turn_speed is not None:
-            turn = _turn_angles(behind[:, :3, :3], ahead[:, :3, :3])
-            rates.append((turn_speed, turn / (2 * _EPS)))
-        for limit, rate in rates:
-            # The largest of its neighbours too: the bound holds between grid points.
-            edge = np.pad(rate, 1, mode="edge")
-            rate = np.maximum.reduce([edge[:-2], rate, edge[2:]])
-            cap = limit * INSIDE / np.maximum(rate, 1e-9)
-            xbound[:, 1] = np.minimum(xbound[:, 1], cap**2)
-        return None, None, None, None, None, None, xbound
-
-
-def _grid(path: BlendedPath) -> np.ndarray:
-    """TOPP-RA's grid points: every piece of the path split into equal intervals."""
-    x = path.poly.x
-    parts = [
-        np.linspace(a, b, max(GRID_PER_PIECE, math.ceil((b - a) / GRID_STEP)) + 1)[:-1]
-        for a, b in itertools.pairwise(x)
-    ]
-    return np.concatenate([*parts, [x[-1]]])
-
-
-def _fastest(path: BlendedPath, grid: np.ndarray, limits: Limits, caps: np.ndarray) -> np.ndarray:
-    """TOPP-RA's time-optimal path velocities sd (N,) at the grid points, each at most its
-    cap (rad of path per s)."""
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(np.full(6, limits.speed * INSIDE)),
-        toppra.constraint.JointAccelerationConstraint(np.full(6, limits.accel * INSIDE)),
-        _SpeedBound(limits, caps),
-    ]
-    algo = toppra.algorithm.TOPPRA(constraints, _Path(path), gridpoints=grid)
-    _, sd, _ = algo.compute_parameterization(0.0, 0.0)
-    if sd is None:
-        raise RuntimeError("TOPP-RA found no parametrization of the path")
-    return np.maximum(sd, 0.0)
 
 
 @dataclass(frozen=True)
@@ -266,7 +166,7 @@ def _ratios(q: np.ndarray, h: float, limits: Limits) -> dict[str, np.ndarray]:
     if limits.tcp_speed is not None:
         steps["tcp_speed"] = np.linalg.norm(np.diff(T[:, :3, 3], axis=0), axis=1) / limits.tcp_speed
     if limits.turn_speed is not None:
-        steps["turn_speed"] = _turn_angles(T[:-1, :3, :3], T[1:, :3, :3]) / limits.turn_speed
+        steps["turn_speed"] = rotation_angles(T[:-1, :3, :3], T[1:, :3, :3]) / limits.turn_speed
     for name, step in steps.items():
         step = step / h
         out[name] = np.maximum(np.append(step, 0.0), np.insert(step, 0, 0.0))
@@ -336,11 +236,17 @@ def _within_limits(
     steps 2-4). Over the speed or acceleration limits, the path velocity is capped around
     the samples that were; over the jerk limit, the smoothing is widened, up to TAU_MAX
     times a_max / j_max, then capped too."""
-    grid = _grid(path)
+    grid = path_grid(path)
     caps = _bend_caps(path, grid, limits)
     tau = tau_0 = limits.accel / limits.jerk / INSIDE
+    fastest = FastestProfile(path, grid, limits)
+    profile, profiled = _Profile.of(grid, fastest(caps)), caps
     for _ in range(PASSES):
-        profile = _Profile.of(grid, _fastest(path, grid, limits, caps))
+        # TOPP-RA again only where the caps changed: a jerk over the limit that the wider
+        # smoothing takes out leaves them (the first pass of most paths: their start's jump
+        # from full acceleration to cruise), and TOPP-RA is most of the timing's cost.
+        if not np.array_equal(caps, profiled):
+            profile, profiled = _Profile.of(grid, fastest(caps)), caps
         t, s, q = _sampled(path, profile, tau, 1.0, dt)
         ratios = _ratios(q, t[1] - t[0], limits)
         slow, jerk = _slowdown(ratios), ratios["jerk"]
