@@ -78,6 +78,8 @@ def joint_path(
     limits, tries = motion_limits(s, carrying=carrying), QUICKEN_TRIES[carrying]
     quick = shortcut(quicken(path, checker, rng, limits, tries=tries, **kw), checker, rng, **kw)
     quick = merge_short_legs(quick, checker, **kw)
+    if quick.shape == path.shape and np.array_equal(quick, path):
+        return path  # nothing was shortened: no timing to compare (a fifth of isolation's)
     # The estimate `quicken` goes by leaves out the corners; the arm's own timing decides,
     # its corners blended where this search's check passes (`GuardedMotion.follow`).
     clear = functools.partial(checker.clearance_ok, **kw)
