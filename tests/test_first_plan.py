@@ -233,3 +233,48 @@ def test_together_goes_on_grasp_by_grasp_where_the_searches_toward_all_found_no_
     assert not isinstance(plan, Failure), plan
     assert searched == [*together, [1], [2], [3], [4]]
     assert grasp is found.ordered()[3] and np.allclose(plan.transit.q[-1], pres[3])
+
+
+@pytest.mark.parametrize("quick_way", [False, True])
+def test_the_user_hears_when_the_short_searches_found_no_way(monkeypatch, quick_way) -> None:
+    """Where the short searches find no way, the pick says it searches longer before the
+    full searches, which take seconds; where a short one finds a way, it says nothing."""
+
+    def search(a, b, checker, rng, s, **kw):
+        quick = s.rrt_max_samples <= first_plan.QUICK_SAMPLES
+        return np.array([a, np.atleast_2d(b)[0]], float) if quick_way or not quick else None
+
+    monkeypatch.setattr(joint_search, "joint_path", search)
+    heard: list[str] = []
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(3)])
+    rng = np.random.default_rng(0)
+    plan, _, _ = plan_first(found, dims.UR5_READY_Q, rng, progress=heard.append)
+    assert not isinstance(plan, Failure), plan
+    assert heard == ([] if quick_way else [first_plan.SEARCHING_LONGER])
+
+
+def test_a_cancel_while_planning_makes_no_further_search(monkeypatch) -> None:
+    """Once `stop` says so (the operator cancelled), no further search is made: the pick's
+    planning fails after the search under way, not after its whole budget of searches
+    (a juice bottle's spent 20-34 s), and nothing more is said."""
+    searched: list[int] = []
+    cancelled = {"now": False}
+
+    def search(a, b, checker, rng, s, **kw):
+        searched.append(s.rrt_max_samples)
+        cancelled["now"] = True  # the operator cancels while the first search runs
+        return None
+
+    monkeypatch.setattr(joint_search, "joint_path", search)
+    heard: list[str] = []
+    found = _grasps_pick(*[(1.5 + 0.05 * k, -0.25, 0.50) for k in range(6)])
+    rng = np.random.default_rng(0)
+    plan, grasp, _ = plan_first(
+        found, dims.UR5_READY_Q, rng, progress=heard.append, stop=lambda: cancelled["now"]
+    )
+    assert isinstance(plan, Failure) and grasp is None
+    assert searched == [first_plan.QUICK_SAMPLES] and heard == []
+    # Uncancelled, the same pick goes on to its full searches.
+    searched.clear()
+    plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0))
+    assert searched.count(get_settings().motion.rrt_max_samples) >= 2

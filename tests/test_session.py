@@ -300,6 +300,46 @@ def test_a_capture_taken_with_the_arm_elsewhere_is_not_reused() -> None:
         session.close()
 
 
+def test_a_cancel_while_the_pick_plans_ends_it_after_the_search_under_way(monkeypatch) -> None:
+    """The user hears that the pick plans, and then that it searches longer; a cancel then
+    ends the job once the search under way is over, not after every search the pick has
+    left (each stood in for by one that finds no way in 1 s), and the arm has not moved."""
+    from laserpick.pipeline import first_plan, joint_search
+
+    searches: list[float] = []
+
+    def slow_no_way(*args, **kw):
+        searches.append(time.monotonic())
+        time.sleep(1.0)
+        return None
+
+    monkeypatch.setattr(joint_search, "joint_path", slow_no_way)
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=False))
+    heard: list[str] = []
+    session.on_event(lambda e: heard.append(e.get("message", "")))
+    try:
+        actor, robot = Actor("bench"), session.robot
+        robot.sleep(0.3)
+        seen = SimTruth(robot).object_points("mug_1")
+        centre = (seen.min(axis=0) + seen.max(axis=0)) / 2
+        session.aim_at(actor, centre, "base")
+        session.confirm(actor, point=centre)
+        _wait(lambda: not session.busy, 120.0)
+        assert session.state == TaskState.GRASPS_READY, session.message
+        q_before = robot.joint_state().q
+        session.execute(actor)
+        _wait(lambda: first_plan.SEARCHING_LONGER in heard, 60.0)
+        assert "Planning the arm's way to the grasp." in heard
+        session.cancel(actor)
+        cancelled, made = time.monotonic(), len(searches)
+        _wait(lambda: not session.busy, 60.0)
+        assert time.monotonic() - cancelled < 2.5 and len(searches) <= made + 1
+        assert session.message == "Cancelled by the operator.", session.message
+        assert np.abs(robot.joint_state().q - q_before).max() < 0.01
+    finally:
+        session.close()
+
+
 def test_after_a_drop_the_arm_stands_by_and_the_next_pick_leaves_from_there() -> None:
     """After a drop in the basket the arm waits for the next pick standing by
     (`UR5_STANDBY_Q`), not stowed: the next pick's way to its grasp keeps the elbow up, does

@@ -51,8 +51,21 @@ class Picking(Withdrawing):
         self.way_in = self.ahead = None
         t0 = time.perf_counter()
         admit = self._basket_admits(grasps) if to_basket else None
-        plan, grasp, attempts = plan_first(grasps, self.current_q(), self.rng, order, s, admit)
+        self.progress("Planning the arm's way to the grasp.")
+        plan, grasp, attempts = plan_first(
+            grasps,
+            self.current_q(),
+            self.rng,
+            order,
+            s,
+            admit,
+            progress=self.progress,
+            stop=self.should_stop,
+        )
         timings = {"plan": time.perf_counter() - t0}
+        if isinstance(plan, Failure) and self.should_stop():
+            failure = Failure("execute", "Stopped while planning: the pick was cancelled.")
+            return Outcome(failure, attempts=attempts, timings=timings)
         if isinstance(plan, Failure):
             msg = f"None of the {attempts} grasps could be planned ({plan.message})"
             if plan.park_left is not None:

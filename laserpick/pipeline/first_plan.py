@@ -29,6 +29,7 @@ from laserpick.types import Failure, Grasp
 __all__ = [
     "QUICK_SAMPLES",
     "READY_TOLERANCE",
+    "SEARCHING_LONGER",
     "UNSEEN_WAYS",
     "at_pose",
     "at_rest",
@@ -43,6 +44,10 @@ UNSEEN_WAYS = (
     "; the only ways found pass where the cameras could not see, and the arm keeps to where"
     " they saw"
 )
+#: Said while a pick plans, when the short searches found no way: the full ones take seconds
+#: (a juice bottle on a high table: 20-34 s beside another bench, where the user saw nothing
+#: new since "Picking.").
+SEARCHING_LONGER = "No way to the grasps was found at once; searching longer, for some seconds."
 #: The short search each grasp's transit gets first (samples; a way that exists is mostly
 #: found within it, in about 0.1 s): a juice bottle on a high table spent three full
 #: searches (12 s on a loaded machine) on grasps whose way up past the board was not
@@ -69,10 +74,15 @@ def plan_first(
     order: Sequence[Grasp] | None = None,
     settings: MotionSettings | None = None,
     admit: Callable[[Grasp], Failure | None] | None = None,
+    *,
+    progress: Callable[[str], None] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[PickPlan | Failure, Grasp | None, int]:
     """Plan the grasps of `order` (default: all, best first) until one plans, as 004 does.
     `admit`, where given, may refuse a grasp before it is planned, with the failure that
-    says why (what comes after the pick needs of it).
+    says why (what comes after the pick needs of it). `progress`, where given, hears
+    `SEARCHING_LONGER` when the short searches found no way; once `stop` returns True (the
+    operator cancelled), no further search is made and the pick's planning fails.
 
     The grasps are planned with short searches first (`QUICK_SAMPLES`), until one plans or
     `rrt_max_failed` of them found no way; then, where none planned, with full searches, best
@@ -106,14 +116,16 @@ def plan_first(
     grasps = list(found.ordered() if order is None else order)
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     pick = _Pick(found, q_now, rng, admit)
-    searches = Searches(s.rrt_max_failed)
+    searches = Searches(s.rrt_max_failed, stop=stop)
     if s.rrt_max_samples > QUICK_SAMPLES:
-        quick = Searches(s.rrt_max_failed)
+        quick = Searches(s.rrt_max_failed, stop=stop)
         short = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})
         done = _quick_pass(pick, grasps, short, via, quick)
         if done.grasp is not None:
             return done.plan, done.grasp, _place(grasps, done.grasp)
         searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
+        if progress is not None and not searches.stopped:
+            progress(SEARCHING_LONGER)
     full = _plan_together if s.grasps_together else _plan_in_order
     first = full(pick, grasps, s, via, searches)
     last = first
@@ -126,6 +138,8 @@ def plan_first(
     if last.grasp is not None:
         return last.plan, last.grasp, _place(grasps, last.grasp)
     plan = last.plan
+    if searches.stopped:
+        return plan, None, first.tried
     if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
         plan = _unseen_ways_failure(plan, found.middle)
     return plan, None, first.tried

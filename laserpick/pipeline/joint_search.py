@@ -11,7 +11,7 @@ Frames: joint angles in rad.
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -157,9 +157,12 @@ class Searches:
     """The joint-space searches of one pick, shared by the grasps it tries: a leg already
     searched is reused (the leg from the stowed arm to the ready pose is the same for every
     grasp), and failed searches are counted, so the pick can stop after `max_failed`. The
-    legs held to seen space that found no way are kept (`blocked`), to say why."""
+    legs held to seen space that found no way are kept (`blocked`), to say why. Once `stop`
+    returns True (the operator cancelled), no further search is made: a leg not yet
+    searched finds no way, and the searches count as spent."""
 
     max_failed: int
+    stop: Callable[[], bool] | None = None
     failed: int = 0
     legs: dict[tuple[bytes, bytes], np.ndarray | None] = field(default_factory=dict)
     blocked: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray, CollisionChecker]] = field(
@@ -180,6 +183,8 @@ class Searches:
         saw through (`CollisionChecker.clearance_ok`), or where it stands at either end (at
         any of the goals)."""
         key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
+        if key not in self.legs and self.stopped:
+            return None
         if key not in self.legs:
             known = checker.knowing(a, *np.atleast_2d(b)) if seen else checker
             self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
@@ -210,5 +215,10 @@ class Searches:
         self.legs = {key: leg for key, leg in self.legs.items() if leg is not None}
 
     @property
+    def stopped(self) -> bool:
+        """Whether `stop` says to make no further search."""
+        return self.stop is not None and self.stop()
+
+    @property
     def spent(self) -> bool:
-        return self.failed >= self.max_failed
+        return self.failed >= self.max_failed or self.stopped
