@@ -183,9 +183,9 @@ class Searches:
         saw through (`CollisionChecker.clearance_ok`), or where it stands at either end (at
         any of the goals)."""
         key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
-        if key not in self.legs and self.stopped:
-            return None
         if key not in self.legs:
+            if self.stopped:
+                return None
             known = checker.knowing(a, *np.atleast_2d(b)) if seen else checker
             self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:

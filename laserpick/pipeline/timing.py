@@ -243,8 +243,8 @@ def _within_limits(
     profile, profiled = _Profile.of(grid, fastest(caps)), caps
     for _ in range(PASSES):
         # TOPP-RA again only where the caps changed: a jerk over the limit that the wider
-        # smoothing takes out leaves them (the first pass of most paths: their start's jump
-        # from full acceleration to cruise), and TOPP-RA is most of the timing's cost.
+        # smoothing takes out leaves them (the first pass of most transits: their jump from
+        # full acceleration to cruise), and TOPP-RA is most of the timing's cost.
         if not np.array_equal(caps, profiled):
             profile, profiled = _Profile.of(grid, fastest(caps)), caps
         t, s, q = _sampled(path, profile, tau, 1.0, dt)
