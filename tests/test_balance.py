@@ -11,7 +11,7 @@ import pytest
 from table_clouds import table_perception
 
 from laserpick.description import dims
-from laserpick.pipeline.balance import carried_lever, hold_lever, holds_across_middle, off_middle
+from laserpick.pipeline.balance import hold_lever, holds_across_middle
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.perceive import Perception
 from laserpick.pipeline.selection import group
@@ -42,29 +42,6 @@ def test_a_holds_lever_is_the_weights_arm_about_the_line_between_the_fingers() -
     assert holds_across_middle(pose, np.array([0.03, 0.0, 0.0]), 0.0)  # 0: off
 
 
-def test_a_hold_is_judged_also_as_the_hand_carries_it_pointing_down() -> None:
-    """Hand-worked: a jar standing at the origin, 10 cm tall, its middle 5 cm up, taken from
-    the side (approach along x, fingers closing along y, the hand's first axis straight
-    down). By its cap, 4 cm above the middle, it hangs level at the grasp, and 4 cm off the
-    line between the fingers once the hand points down: across its middle only at the
-    grasp. By its middle it is across it both ways; and from above, the two levers are
-    one."""
-    middle = np.array([0.0, 0.0, 0.05])
-    side = np.eye(4)
-    side[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
-    side[:3, 3] = [0.0, 0.0, 0.09]
-    assert hold_lever(side, middle) == pytest.approx(0.0)
-    assert carried_lever(side, middle) == pytest.approx(0.04)
-    assert off_middle(side, middle, 0.02) == (False, True)
-    side[:3, 3] = [0.0, 0.0, 0.055]
-    assert off_middle(side, middle, 0.02) == (False, False)
-    assert off_middle(side, None, 0.02) == off_middle(side, middle, 0.0) == (False, False)
-    top = np.eye(4)
-    top[:3, :3] = np.diag([1.0, -1.0, -1.0])  # approach straight down, fingers along y
-    top[:3, 3] = [0.03, 0.01, 0.1]
-    assert carried_lever(top, middle) == pytest.approx(hold_lever(top, middle)) == 0.03
-
-
 def _grasp(x: float, score: float, centred: bool = True) -> Grasp:
     pose = np.eye(4)
     pose[:3, 3] = [x, 0.0, 0.5]
@@ -83,32 +60,6 @@ def test_grasps_across_the_middle_are_offered_before_better_scored_ones_off_it()
     assert [g.position[0] for g in first] == [1.005, 1.06, 0.94]
     unjudged = group([off, across, edge], s)  # no middle: by score, as 004
     assert [unjudged.grasps[m[0]].position[0] for m in unjudged.clusters] == [1.06, 1.005, 0.94]
-
-
-def _side_grasp(x: float, z: float, score: float) -> Grasp:
-    """A grasp from the side at (x, 0, z): approach along +x, fingers closing along y, the
-    hand's first axis straight down."""
-    pose = np.eye(4)
-    pose[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
-    pose[:3, 3] = [x, 0.0, z]
-    scores = GraspScores(Cw=score, Cj=1.0, Ca=1.0, Cs=1.0, Cp=1.0)
-    return Grasp(pose=pose, width=0.04, scores=scores)
-
-
-def test_grasps_held_across_the_middle_also_carried_come_before_those_held_by_an_end() -> None:
-    """A jar standing with its middle at (1.0, 0, 0.55), taken from the side: by its cap
-    (4 cm above the middle, best scored) it hangs level at the grasp but turns once
-    carried, so a grasp across its middle comes first; a grasp 5 cm in front of the middle,
-    off it already at the grasp, comes after both."""
-    middle = np.array([1.0, 0.0, 0.55])
-    by_cap, across, in_front = (
-        _side_grasp(1.0, 0.59, 0.9),
-        _side_grasp(1.0, 0.555, 0.5),
-        _side_grasp(0.95, 0.55, 0.95),
-    )
-    ordered = group([in_front, by_cap, across], Settings().grasp, middle)
-    offered = [tuple(ordered.grasps[i].position) for m in ordered.clusters for i in m]
-    assert offered == [tuple(g.position) for g in (across, by_cap, in_front)]
 
 
 def _remote_seen_from_the_left(centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -25,7 +25,7 @@ import numpy as np
 from laserpick.behaviours import warm_drop_postures
 from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
-from laserpick.pipeline.balance import hold_lever, off_middle
+from laserpick.pipeline.balance import hold_lever
 from laserpick.pipeline.first_plan import at_rest
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
@@ -262,15 +262,13 @@ class ScriptedOperator:
         at all; none such: back to the system's choice. What the user sees of each object
         is `seen`, the points the cameras saw on it (m, `base`; `View.points`): a grasp is
         on the object whose seen points lie nearest its TCP, within 4 cm, and across its
-        middle with a lever of at most LEVER_MAX about the middle of its seen extent
-        (`seen_middle`), as it hangs at the grasp and as it is carried (`off_middle`);
-        else across it at the grasp. Clusters where a choice failed to plan before are
-        passed by while another on `instance` is left: a person does not choose again what
-        they saw fail."""
+        middle with a `lever` of at most LEVER_MAX about the middle of its seen extent
+        (`seen_middle`). Clusters where a choice failed to plan before are passed by while
+        another on `instance` is left: a person does not choose again what they saw fail."""
         s = self.session
         failed = self._unplanned.get(instance, [])
         middle = seen_middle(seen[instance]) if instance in seen else None
-        best: tuple[tuple[bool, bool, bool], int] | None = None  # (tried, off balance), cluster
+        best: tuple[tuple[bool, bool], int] | None = None  # (tried, off balance), cluster
         for k in range(s.status()["grasps"]["clusters"]):
             s.select_grasp(BENCH, k, 0)
             pose = np.asarray(s.status()["current"]["pose"])
@@ -278,8 +276,8 @@ class ScriptedOperator:
                 continue
             at = self.referee.to_world(pose[:3, 3])
             tried = any(np.linalg.norm(at - p) < UNPLANNED_NEAR for p in failed)
-            rank = (tried, *off_middle(pose, middle, LEVER_MAX))
-            if rank == (False, False, False):
+            rank = (tried, hold_lever(pose, middle) > LEVER_MAX)
+            if rank == (False, False):
                 return
             if best is None or rank < best[0]:
                 best = (rank, k)

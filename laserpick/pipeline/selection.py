@@ -16,7 +16,7 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 
 from laserpick.description.dims import GRIPPER_HAND
-from laserpick.pipeline.balance import off_middle
+from laserpick.pipeline.balance import holds_across_middle
 from laserpick.settings import GraspSettings, get_settings
 from laserpick.types import Grasp, GraspScores
 
@@ -128,9 +128,8 @@ def group(
 ) -> GraspClusters:
     """Cluster grasps by position (004 section 7.2) and order everything by score, those
     whose pads meet the object about their middle first (`Grasp.pads_centred`), and among
-    them those that hold the object across its `middle` (m, `base`) as it hangs at the
-    grasp and as it is carried, then those across it at the grasp (`off_middle`): the
-    grasps in each cluster, and the clusters by their first grasp.
+    them those that hold the object across its `middle` (m, `base`; `holds_across_middle`):
+    the grasps in each cluster, and the clusters by their first grasp.
 
     Ours: 004 orders by score alone. But C does not see where along the pads the object
     lies, nor where along the object the hand holds it: a can met only toward the pads'
@@ -145,9 +144,10 @@ def group(
     for i, label in enumerate(labels):
         members.setdefault(int(label), []).append(i)
 
-    def rank(i: int) -> tuple[bool, bool, bool, float]:
+    def rank(i: int) -> tuple[bool, bool, float]:
         g = grasps[i]
-        return not g.pads_centred, *off_middle(g.pose, middle, s.balance_lever), -g.score
+        across = holds_across_middle(g.pose, middle, s.balance_lever)
+        return not g.pads_centred, not across, -g.score
 
     ordered = [sorted(m, key=rank) for m in members.values()]
     ordered.sort(key=lambda m: rank(m[0]))

@@ -74,11 +74,9 @@ class GraspSettings(BaseModel):
         ge=0,
         description="Farthest (m) a grasp may hold the object's seen middle from the line"
         " between its fingers, as gravity sees it (`pipeline.balance`), and still count as"
-        " across the middle: grasps across it at the grasp and as the hand carries the object"
-        " pointing down are offered first, then those across it at the grasp only, then the"
-        " others; where GPD's reachable grasps are all farther off at the grasp, its pass on"
-        " the target completed by symmetry runs too. A person holds a remote across its middle."
-        " 0 turns it off. Ours.",
+        " across the middle: grasps farther off are offered after the others, and where GPD's"
+        " reachable grasps are all farther off, its pass on the target completed by symmetry"
+        " runs too. A person holds a remote across its middle. 0 turns it off. Ours.",
     )
     gpd_tilts_deg: tuple[float, ...] = Field(
         (-60.0, -30.0, 30.0, 60.0),
