@@ -7,7 +7,10 @@ in turn (so both meet the same machine load), with the motion settings' sample b
 
 - ours: `rrt.rrt_connect` (extension step `rrt_step`, largest joint) and `rrt.shortcut`;
   with `--full-steps`, also without its shorter steps out of a pocket (`rrt.POCKET_TRAPS`);
-- ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker).
+- ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker);
+- with `--short-first`, ours as a pick runs it: a short search (`first_plan.QUICK_SAMPLES`)
+  and, where it finds no way, the full one, started anew (as before searches grew on) or
+  grown on from the short one's trees (`rrt.ConnectSearch`), both from the same draws.
 
 Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s),
 the joint-space path length (rad, summed Euclidean norm of the steps; median and mean over
@@ -34,9 +37,10 @@ from pathlib import Path
 import numpy as np
 
 from laserpick.pipeline.collision import CollisionChecker
+from laserpick.pipeline.first_plan import QUICK_SAMPLES
 from laserpick.pipeline.ompl_search import OMPL_RANGE, ompl_connect
 from laserpick.pipeline.plan_record import load_search
-from laserpick.pipeline.rrt import POCKET_TRAPS, rrt_connect, shortcut
+from laserpick.pipeline.rrt import POCKET_TRAPS, ConnectSearch, rrt_connect, shortcut
 from laserpick.settings import MotionSettings, get_settings
 
 Planner = Callable[
@@ -62,6 +66,23 @@ def ours(q0, q1, checker, rng, s, kw, pocket_traps: int | None = POCKET_TRAPS):
 def ours_full_steps(q0, q1, checker, rng, s, kw):
     """Ours without the shorter steps out of a pocket (`rrt.POCKET_TRAPS`)."""
     return ours(q0, q1, checker, rng, s, kw, pocket_traps=None)
+
+
+def short_then(grow: bool) -> Planner:
+    """Ours after a short search of QUICK_SAMPLES that found no way: anew, or grown on."""
+
+    def planner(q0, q1, checker, rng, s, kw):
+        search = ConnectSearch(q0, q1, checker, rng, step=s.rrt_step, **kw)
+        path = search.grow(QUICK_SAMPLES)
+        if path is None and grow:
+            path = search.grow(s.rrt_max_samples)
+        elif path is None:
+            path = ConnectSearch(q0, q1, checker, rng, step=s.rrt_step, **kw).grow(
+                s.rrt_max_samples
+            )
+        return None if path is None else shortcut(path, checker, rng, **kw)
+
+    return planner
 
 
 def ompl_with(search_range: float) -> Planner:
@@ -172,6 +193,11 @@ def main() -> None:
         action="store_true",
         help="also ours without the shorter steps out of a pocket (rrt.POCKET_TRAPS)",
     )
+    ap.add_argument(
+        "--short-first",
+        action="store_true",
+        help="ours only, after a short search that found no way: the full one anew or grown on",
+    )
     args = ap.parse_args()
     files = sorted(itertools.chain.from_iterable(f.glob("*.npz") for f in args.folders))
     planners: dict[str, Planner] = {"ours": ours}
@@ -179,6 +205,8 @@ def main() -> None:
         planners["ours, full steps"] = ours_full_steps
     for r in args.ranges:
         planners[f"ompl (range {r:.2f})"] = ompl_with(r)
+    if args.short_first:
+        planners = {"short, then anew": short_then(False), "short, then grown on": short_then(True)}
     print(f"{len(files)} problems, {args.seeds} seeds each")
     report(run(files, planners, args.seeds))
 

@@ -1,6 +1,7 @@
 """Our joint-space search, the default: RRT-Connect (Kuffner and LaValle 2000) with random
 shortcuts, beside OMPL's (`ompl_search`; `bench/planners.py` compares the two), and the box
-of joint angles both draw their samples from.
+of joint angles both draw their samples from. A search of ours that found no way can be
+grown on (`ConnectSearch`).
 
 Frames: joint angles in rad.
 """
@@ -14,7 +15,7 @@ import numpy as np
 from laserpick.description import dims
 from laserpick.pipeline.collision import CollisionChecker
 
-__all__ = ["rrt_connect", "search_bounds", "shortcut"]
+__all__ = ["ConnectSearch", "rrt_connect", "search_bounds", "shortcut"]
 
 #: A tree that meets this many blocked steps before it has POCKET_NODES nodes grows from a
 #: pocket, and steps POCKET_STEP of the full step while it is that small: a tall box held
@@ -99,48 +100,93 @@ def rrt_connect(
     pocket_traps: int | None = POCKET_TRAPS,
     **kw,
 ) -> np.ndarray | None:
-    """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples.
+    """A clear joint path (K, 6) from q_start to q_goal, or None after `max_samples` samples:
+    `ConnectSearch` grown once."""
+    search = ConnectSearch(
+        q_start, q_goal, checker, rng, step=step, pocket_traps=pocket_traps, **kw
+    )
+    return search.grow(max_samples)
+
+
+class ConnectSearch:
+    """RRT-Connect from q_start to q_goal, which can be grown on where it found no way yet.
 
     Two trees grow toward random samples within the joint limits and toward each other, in
-    steps of at most `step` rad (largest joint); each new edge is collision-checked. A tree
-    still small after `pocket_traps` blocked steps takes shorter ones (POCKET_TRAPS; None:
-    never). q_goal (k, 6) gives k goals: the goal side grows from all of them at once, and
-    the path ends at the one it reached first.
+    steps of at most `step` rad (largest joint); each new edge is collision-checked with
+    `checker` (its options `kw`). A tree still small after `pocket_traps` blocked steps takes
+    shorter ones (POCKET_TRAPS; None: never). q_goal (k, 6) gives k goals: the goal side
+    grows from all of them at once, and the path ends at the one it reached first. Its draws
+    come from `rng`, as it grows: grown to N samples in one go or in several, it draws and
+    finds the same.
     """
-    start = np.asarray(q_start, float)
-    goals = np.atleast_2d(np.asarray(q_goal, float))
-    lo, hi = search_bounds(start, goals)
-    trees = [_Tree(start), _Tree(goals)]
 
-    def extend(tree: _Tree, target: np.ndarray) -> tuple[str, int]:
+    def __init__(
+        self,
+        q_start: np.ndarray,
+        q_goal: np.ndarray,
+        checker: CollisionChecker,
+        rng: np.random.Generator,
+        *,
+        step: float = 0.3,
+        pocket_traps: int | None = POCKET_TRAPS,
+        **kw,
+    ) -> None:
+        self.start = np.asarray(q_start, float)
+        self.goals = np.atleast_2d(np.asarray(q_goal, float))
+        self.checker, self.rng, self.kw = checker, rng, kw
+        self.step, self.pocket_traps = step, pocket_traps
+        self.bounds = search_bounds(self.start, self.goals)
+        #: the tree that grows toward the next sample first; they swap after every sample
+        self.trees = [_Tree(self.start), _Tree(self.goals)]
+        self._goal_tree = self.trees[1]
+        #: samples drawn so far
+        self.samples = 0
+
+    def add_goals(self, goals: np.ndarray, checker: CollisionChecker) -> None:
+        """Grow on toward `goals` (k, 6) rad too, checked with `checker` from now on: one that
+        counts no less as clear than the search's own (`CollisionChecker.knowing` of more
+        configurations), so that the trees grown so far stay clear by it."""
+        new = [g for g in np.atleast_2d(goals) if not (self.goals == g).all(axis=1).any()]
+        self._goal_tree.nodes += new
+        self._goal_tree.parents += [-1] * len(new)
+        self.goals = np.vstack([self.goals, *new])
+        self.bounds = search_bounds(self.start, self.goals)
+        self.checker = checker
+
+    def grow(self, max_samples: int) -> np.ndarray | None:
+        """Draw samples until the trees meet, or `max_samples` have been drawn in all: the
+        path (K, 6) rad from the start to the goal it reached, or None."""
+        trees = self.trees
+        while self.samples < max_samples:
+            self.samples += 1
+            status, a = self._extend(trees[0], self.rng.uniform(*self.bounds))
+            if status != "trapped":
+                q_new = trees[0].nodes[a]
+                while True:  # connect: the other tree steps toward q_new until blocked or there
+                    status, b = self._extend(trees[1], q_new)
+                    if status != "advanced":
+                        break
+                if status == "reached":
+                    path = trees[0].branch(a)[::-1] + trees[1].branch(b)[1:]
+                    if not np.array_equal(path[0], self.start):  # swapped an odd time
+                        path = path[::-1]
+                    return np.array(path)
+            trees.reverse()
+        return None
+
+    def _extend(self, tree: _Tree, target: np.ndarray) -> tuple[str, int]:
+        """Step `tree` from its node nearest `target` toward it: "reached", "advanced" or
+        "trapped" (the step was blocked), and the node it ends at."""
         nodes = tree.nodes
         near = int(np.argmin(np.max(np.abs(np.array(nodes) - target), axis=1)))
         delta = target - nodes[near]
         span = float(np.max(np.abs(delta)))
-        reach = step * POCKET_STEP if tree.in_pocket(pocket_traps) else step
+        reach = self.step * POCKET_STEP if tree.in_pocket(self.pocket_traps) else self.step
         reached = span <= reach
         q_new = target if reached else nodes[near] + delta * (reach / span)
-        if not checker.segment_ok(nodes[near], q_new, **kw):
+        if not self.checker.segment_ok(nodes[near], q_new, **self.kw):
             tree.blocked += 1
             return "trapped", near
         nodes.append(q_new)
         tree.parents.append(near)
         return ("reached" if reached else "advanced"), len(nodes) - 1
-
-    for _ in range(max_samples):
-        q_rand = rng.uniform(lo, hi)
-        status, a = extend(trees[0], q_rand)
-        if status != "trapped":
-            q_new = trees[0].nodes[a]
-            while True:  # connect: the other tree steps toward q_new until blocked or there
-                status, b = extend(trees[1], q_new)
-                if status != "advanced":
-                    break
-            if status == "reached":
-                half_a, half_b = trees[0].branch(a), trees[1].branch(b)
-                path = half_a[::-1] + half_b[1:]
-                if not np.array_equal(path[0], start):  # the trees were swapped an odd time
-                    path = path[::-1]
-                return np.array(path)
-        trees.reverse()
-    return None
