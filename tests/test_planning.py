@@ -231,33 +231,6 @@ def test_a_search_grown_in_parts_draws_and_finds_as_one_grown_at_once():
     assert whole is not None and parts is not None and np.array_equal(whole, parts)
 
 
-def test_a_short_search_that_found_no_way_grows_on_toward_more_goals():
-    """A pick's short search across a wall finds no way; the full search from the same start
-    toward its goal and another grows that search on (its samples go on counting) rather
-    than starting anew. Once the failed legs are forgotten, a search starts anew."""
-    q0, q1, checker = _wall_between()
-    turned = q1 + np.array([0, 0, 0, 0, 0, 0.5])  # the wrist turned: beyond the wall too
-    assert checker.clearance_ok(turned)[0] and not checker.segment_ok(q0, turned)
-    full = get_settings().motion.model_copy(update={"planner": "ours", "quicken_paths": False})
-    short = full.model_copy(update={"rrt_max_samples": 2})
-    rng = np.random.default_rng(0)
-    quick = Searches(6)
-    assert quick.path(q0, turned, checker, rng, short) is None
-    [(_, _, search)] = quick.growing
-    assert search.samples == 2
-    searches = Searches(6)
-    searches.carry_on(quick)
-    path = searches.path(q0, np.stack([q1, turned]), checker, rng, full)
-    assert path is not None and any(np.array_equal(path[-1], g) for g in (q1, turned))
-    assert search.samples > 2 and len(search.goals) == 2, "the short search grew on"
-    assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
-    assert searches.growing == []
-    assert searches.path(q0, q1, checker, rng, short) is None
-    assert len(searches.growing) == 1
-    searches.forget_failed()
-    assert searches.growing == []
-
-
 def test_a_tree_in_a_pocket_steps_out_with_shorter_steps():
     """A cereal box's carry recorded in `isolation` (seed 8): held by its top, the box hangs
     low in the basket at the goal, where 0 of 64 full steps are clear. The goal's tree steps

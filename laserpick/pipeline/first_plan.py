@@ -123,7 +123,7 @@ def plan_first(
         done = _quick_pass(pick, grasps, short, via, quick)
         if done.grasp is not None:
             return done.plan, done.grasp, _place(grasps, done.grasp)
-        searches.carry_on(quick)
+        searches.legs.update((key, leg) for key, leg in quick.legs.items() if leg is not None)
         if progress is not None and not searches.stopped:
             progress(SEARCHING_LONGER)
     full = _plan_together if s.grasps_together else _plan_in_order

@@ -22,7 +22,7 @@ from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.ompl_search import ompl_connect
 from laserpick.pipeline.plan_record import record_search
 from laserpick.pipeline.quicken import merge_short_legs, quicken
-from laserpick.pipeline.rrt import ConnectSearch, shortcut
+from laserpick.pipeline.rrt import rrt_connect, shortcut
 from laserpick.settings import MotionSettings
 
 __all__ = [
@@ -52,8 +52,6 @@ def joint_path(
     checker: CollisionChecker,
     rng: np.random.Generator,
     s: MotionSettings,
-    *,
-    grown: list[ConnectSearch] | None = None,
     **kw,
 ) -> np.ndarray | None:
     """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
@@ -64,10 +62,6 @@ def joint_path(
 
     q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
     else a search toward those that are clear (`_search`), which ends at the goal it reaches.
-    grown: where given, a search of ours that found no way within fewer samples, from
-    q_start toward some of the goals, grows on toward them all (`ConnectSearch.add_goals`)
-    from its first item, rather than a new one starting; the search made or grown is left
-    in it as its only item.
     """
     goals = np.atleast_2d(np.asarray(q_goal, float))
     for goal in goals:
@@ -76,7 +70,7 @@ def joint_path(
     ends_clear = checker.clearance_ok(np.vstack([q_start, goals]), **kw)
     if not ends_clear[0] or not ends_clear[1:].any():
         return None
-    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw, grown)
+    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw)
     if path is None or not s.quicken_paths:
         return path
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
@@ -99,28 +93,20 @@ def _search(
     rng: np.random.Generator,
     s: MotionSettings,
     kw: dict,
-    grown: list[ConnectSearch] | None = None,
 ) -> np.ndarray | None:
     """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first;
     None where the search found none. Ours grows the goal side from every goal at once:
     searched one after another, goals in a pocket spent the whole search each (a cereal
     box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
     its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
-    it searches them one after another. grown: as `joint_path` takes it (ours only)."""
-    if s.planner == "ours":
-        search = grown[0] if grown else None
-        if search is None:
-            for goal in goals:
-                record_search(q_start, goal, checker, kw)
-            search = ConnectSearch(q_start, goals, checker, rng, step=s.rrt_step, **kw)
-        else:
-            search.add_goals(goals, checker)
-        if grown is not None:
-            grown[:] = [search]
-        path = search.grow(s.rrt_max_samples)
-        return None if path is None else shortcut(path, checker, rng, **kw)
+    it searches them one after another."""
     for goal in goals:
         record_search(q_start, goal, checker, kw)
+    if s.planner == "ours":
+        path = rrt_connect(
+            q_start, goals, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
+        )
+        return None if path is None else shortcut(path, checker, rng, **kw)
     budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
     for goal in goals:
         path = ompl_connect(q_start, goal, checker, rng, **budget, **kw)
@@ -173,12 +159,7 @@ class Searches:
     grasp), and failed searches are counted, so the pick can stop after `max_failed`. The
     legs held to seen space that found no way are kept (`blocked`), to say why. Once `stop`
     returns True (the operator cancelled), no further search is made: a leg not yet
-    searched finds no way, and the searches count as spent.
-
-    The searches of ours that found no way are kept too (`growing`): where the same leg, or
-    one from the same start toward more goals, is searched with more samples, that search
-    grows on rather than a new one starting (`carry_on`): the pick's short searches, 0.6-0.8
-    s each where they fail (replayed beside two benches), are then not spent again."""
+    searched finds no way, and the searches count as spent."""
 
     max_failed: int
     stop: Callable[[], bool] | None = None
@@ -187,7 +168,6 @@ class Searches:
     blocked: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray, CollisionChecker]] = field(
         default_factory=dict
     )
-    growing: list[tuple[bytes, bool, ConnectSearch]] = field(default_factory=list)
 
     def path(
         self,
@@ -207,43 +187,13 @@ class Searches:
             if self.stopped:
                 return None
             known = checker.knowing(a, *np.atleast_2d(b)) if seen else checker
-            grown = self._grown_toward(key[0], b, seen, s)
-            self.legs[key] = joint_path(a, b, known, rng, s, grown=grown, hand=True, seen=seen)
-            if self.legs[key] is None and grown:
-                self.growing.append((key[0], seen, grown[0]))
+            self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
             if self.legs[key] is None:
                 self.failed += 1
                 # Keyed as `legs`: searched again after `forget_failed`, still one leg.
                 if seen and checker.frames:
                     self.blocked.setdefault(key, (a, b, checker))
         return self.legs[key]
-
-    def _grown_toward(
-        self, start: bytes, b: np.ndarray, seen: bool, s: MotionSettings
-    ) -> list[ConnectSearch]:
-        """The kept search from the start whose bytes are `start` (with the same `seen`)
-        toward goals all among `b` (k, 6) rad that may grow on (fewer than `s.rrt_max_samples`
-        drawn), the one toward most goals, taken from `growing`: as `joint_path` takes it
-        (empty where there is none)."""
-        goals = np.atleast_2d(np.asarray(b, float))
-        fits = [
-            k
-            for k, (at, held, search) in enumerate(self.growing)
-            if at == start
-            and held == seen
-            and search.samples < s.rrt_max_samples
-            and all((goals == g).all(axis=1).any() for g in search.goals)
-        ]
-        if not fits:
-            return []
-        best = max(fits, key=lambda k: len(self.growing[k][2].goals))
-        return [self.growing.pop(best)[2]]
-
-    def carry_on(self, earlier: Searches) -> None:
-        """Take on the legs the `earlier` searches found, and their searches that found none,
-        to grow on (`growing`)."""
-        self.legs.update((key, leg) for key, leg in earlier.legs.items() if leg is not None)
-        self.growing += earlier.growing
 
     def unseen_only(self, s: MotionSettings) -> bool:
         """Whether one of the first BLIND_LEGS `blocked` legs has a way through space no
@@ -263,7 +213,6 @@ class Searches:
         """Let the legs that found no way be searched again, with new draws; the failures
         stay counted against `max_failed`."""
         self.legs = {key: leg for key, leg in self.legs.items() if leg is not None}
-        self.growing = []
 
     @property
     def stopped(self) -> bool:

@@ -138,20 +138,8 @@ class ConnectSearch:
         self.bounds = search_bounds(self.start, self.goals)
         #: the tree that grows toward the next sample first; they swap after every sample
         self.trees = [_Tree(self.start), _Tree(self.goals)]
-        self._goal_tree = self.trees[1]
         #: samples drawn so far
         self.samples = 0
-
-    def add_goals(self, goals: np.ndarray, checker: CollisionChecker) -> None:
-        """Grow on toward `goals` (k, 6) rad too, checked with `checker` from now on: one that
-        counts no less as clear than the search's own (`CollisionChecker.knowing` of more
-        configurations), so that the trees grown so far stay clear by it."""
-        new = [g for g in np.atleast_2d(goals) if not (self.goals == g).all(axis=1).any()]
-        self._goal_tree.nodes += new
-        self._goal_tree.parents += [-1] * len(new)
-        self.goals = np.vstack([self.goals, *new])
-        self.bounds = search_bounds(self.start, self.goals)
-        self.checker = checker
 
     def grow(self, max_samples: int) -> np.ndarray | None:
         """Draw samples until the trees meet, or `max_samples` have been drawn in all: the
