@@ -9,8 +9,8 @@ in turn (so both meet the same machine load), with the motion settings' sample b
   with `--full-steps`, also without its shorter steps out of a pocket (`rrt.POCKET_TRAPS`);
 - ompl: `ompl_search.ompl_connect` (OMPL's RRTConnect and PathSimplifier, our checker);
 - with `--short-first`, ours as a pick runs it: a short search (`first_plan.QUICK_SAMPLES`)
-  and, where it finds no way, the full one, started anew (as before searches grew on) or
-  grown on from the short one's trees (`rrt.ConnectSearch`), both from the same draws.
+  and, where it finds no way, the full one, started anew (as a pick does) or grown on from
+  the short one's trees (`rrt.ConnectSearch`), both from the same draws.
 
 Prints, per planner, the success rate, the wall-clock planning time (median, mean, p90, s),
 the joint-space path length (rad, summed Euclidean norm of the steps; median and mean over
