@@ -9,10 +9,9 @@ import numpy as np
 from laserpick.description import dims
 from laserpick.pipeline.collision import carried_shape
 from laserpick.pipeline.free_space import (
-    ALL_AT_ONCE_MAX,
     AT_ONCE_MAX,
+    CAPTURE_FRAMES,
     OBJECT_SPAN_MAX,
-    ONE_BY_ONE,
     beyond_view,
     finger_probes,
     fingers_seen_free,
@@ -123,28 +122,28 @@ def test_several_frames_free_a_point_where_any_one_of_them_does():
 
 
 def test_many_frames_asked_at_once_free_what_each_alone_frees():
-    """Few points are asked of all frames at once (`ALL_AT_ONCE_MAX`); many, of the first
-    ONE_BY_ONE frames one by one, then of the rest at once where the points left are few
+    """The capture's frames are asked first (`CAPTURE_FRAMES`), then the rest about the points
+    left; each group at once where the points are few, else frame by frame until they are
     (`AT_ONCE_MAX`): a point is free exactly where one frame, asked alone, sees past it,
     however many points are asked and whichever way they are."""
     # The first frames from the front, the rest from either side, which see into the box's
     # shadow as the first do not.
-    eyes = [CAMERA + [dx, 0.0, 0.0] for dx in (0.0, -0.05, -0.1, -0.15)]
+    eyes = [CAMERA + [dx, 0.0, 0.0] for dx in (0.0, -0.05, -0.1, -0.15, -0.2)]
     eyes += [CAMERA + [dx, dy, 0.0] for dx in (0.3, 0.6) for dy in (-0.6, 0.6)]
     frames = [_frame(eye=eye, look_at=BOX_CENTRE + [0.0, 0.0, -0.1]) for eye in eyes]
-    assert len(frames) > ONE_BY_ONE
+    assert len(frames) > CAPTURE_FRAMES
     rng = np.random.default_rng(1)
     around = ([-0.2, -0.2, -0.09], [0.2, 0.2, 0.15])
     behind = ([0.04, -0.03, -0.09], [0.2, 0.03, 0.09])  # in the shadow of the front frames
-    # Few points, asked of all frames at once; too many, one frame after another until few
-    # are left, then the frames after that at once.
-    assert 50 * len(frames) <= ALL_AT_ONCE_MAX < AT_ONCE_MAX * len(frames)
+    # Few points, each group asked at once; too many, one frame after another until few are
+    # left, then the frames after that at once.
+    assert 50 * len(frames) <= AT_ONCE_MAX < AT_ONCE_MAX * CAPTURE_FRAMES
     for n, (lo, hi) in ((50, around), (AT_ONCE_MAX, behind)):
         points = BOX_CENTRE + rng.uniform(lo, hi, (n, 3))
         tol = rng.uniform(0.0, 0.03, n)
         alone = np.array([seen_free(points, [f], tol) for f in frames])
-        first, rest = alone[:ONE_BY_ONE].any(axis=0), alone[ONE_BY_ONE:].any(axis=0)
-        assert (rest & ~first).any()  # the frames asked at once free some points themselves
+        first, rest = alone[:CAPTURE_FRAMES].any(axis=0), alone[CAPTURE_FRAMES:].any(axis=0)
+        assert (rest & ~first).any()  # the frames asked after the capture's free some points
         assert (seen_free(points, frames, tol) == alone.any(axis=0)).all()
 
 

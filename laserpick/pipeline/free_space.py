@@ -34,15 +34,17 @@ PROBE_DOWN = (0.15, 0.5, 0.85)
 VIEW_EDGE_PX = 8
 #: Fewest target points at the view's edge for the object to count as cut off by it.
 CUT_MIN_POINTS = 5
-#: `seen_free` asks all frames at once where the points times the frames are at most
-#: ALL_AT_ONCE_MAX pairs; more, it asks the first ONE_BY_ONE frames one by one, each about
-#: the points no earlier frame saw past, and the rest at once where those left times the
-#: frames left are at most AT_ONCE_MAX (past that, the one product costs more than the
-#: frames one by one, which see most points free early). Measured (CPU time) on a kitchen
-#: capture's 45 frames, points where the hand goes: all at once is 14 times quicker for 60
-#: points, 1.4 times at 700, slower from about 1400.
-ALL_AT_ONCE_MAX = 30_000
-ONE_BY_ONE = 4
+#: `seen_free` asks the first CAPTURE_FRAMES frames (a stack's first frames are its
+#: capture's, whose five cameras see past most points where the hand goes), then the rest
+#: about the points those did not see past; each group at once where the points left times
+#: its frames are at most AT_ONCE_MAX pairs, else one frame after another until they are
+#: (past that, the one product costs more than the frames one by one, which see most points
+#: free early). Measured (CPU time) on a kitchen capture's 45 frames, points where the hand
+#: goes: all at once is 14 times quicker than frame by frame for 60 points, 1.4 times at
+#: 700, slower from about 1400. On 5000 calls of a kitchen's pick searches (584 points on
+#: average), the capture's frames first gave the same verdicts in 1.7-2.0 s of CPU against
+#: 2.8 s all at once (`bench/seen_space_cost.py`, `in-situ` 7305).
+CAPTURE_FRAMES = 5
 AT_ONCE_MAX = 100_000
 #: The longest (m) an object the hand carries is taken to be where the cameras' view cut it
 #: off (the kitchen's longest, the juice bottle, is 20.6 cm).
@@ -70,22 +72,18 @@ def seen_free(
     tolerance = np.broadcast_to(np.asarray(tolerance, np.float64), (len(points),))
     if not frames:
         return np.zeros(len(points), bool)
-    # All at once where the pairs are few: a search held to seen space asks about tens to
-    # hundreds of points thousands of times, and per frame asked, the calls cost more than
-    # the arithmetic (60 points of 45 frames: 0.06 ms, against 0.9 ms frame by frame).
+    # A search held to seen space asks about tens to hundreds of points thousands of times,
+    # and per frame asked, the calls cost more than the arithmetic (CAPTURE_FRAMES).
     stack = frame_stack(frames)
-    if len(points) * len(frames) <= ALL_AT_ONCE_MAX:
-        return stack.seen_past(points, tolerance)
     free = np.zeros(len(points), bool)
     todo = np.arange(len(points))
-    for k in range(len(frames)):
-        if not len(todo):
-            break
-        if k >= ONE_BY_ONE and len(todo) * (len(frames) - k) <= AT_ONCE_MAX:
-            free[todo] = stack.seen_past(points[todo], tolerance[todo], k)
-            break
-        free[todo] = stack.seen_past(points[todo], tolerance[todo], k, k + 1)
-        todo = todo[~free[todo]]
+    first = min(CAPTURE_FRAMES, len(frames))
+    for lo, hi in ((0, first), (first, len(frames))):
+        k = lo
+        while len(todo) and k < hi:
+            last = hi if len(todo) * (hi - k) <= AT_ONCE_MAX else k + 1
+            free[todo] = stack.seen_past(points[todo], tolerance[todo], k, last)
+            todo, k = todo[~free[todo]], last
     return free
 
 
