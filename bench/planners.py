@@ -74,12 +74,9 @@ def short_then(grow: bool) -> Planner:
     def planner(q0, q1, checker, rng, s, kw):
         search = ConnectSearch(q0, q1, checker, rng, step=s.rrt_step, **kw)
         path = search.grow(QUICK_SAMPLES)
-        if path is None and grow:
-            path = search.grow(s.rrt_max_samples)
-        elif path is None:
-            path = ConnectSearch(q0, q1, checker, rng, step=s.rrt_step, **kw).grow(
-                s.rrt_max_samples
-            )
+        if path is None:
+            full = search if grow else ConnectSearch(q0, q1, checker, rng, step=s.rrt_step, **kw)
+            path = full.grow(s.rrt_max_samples)
         return None if path is None else shortcut(path, checker, rng, **kw)
 
     return planner
