@@ -75,10 +75,33 @@ class Leaving(Withdrawing):
             T_up[:3, 3] += eased
             self.rise_straight(T_up, "rising from the object")
             return None
-        failure = self.run_withdrawal(back)
+        failure = self._draw_back_by_touch(back, approach, checker)
         if failure is None and on_floor:
             self._rise_to(float(T_above[2, 3]), checker)
         return failure
+
+    def _draw_back_by_touch(
+        self, back: np.ndarray, approach: np.ndarray, checker: CollisionChecker
+    ) -> Failure | None:
+        """Draw the open hand back along `back` (N, 6) rad, guarded at `leave_nudge` over
+        what the pads bear: where a pad brushes what it let go of, the hand stops, eases
+        the pads off it sideways (`_slide_pads_off`) and draws back from there along its
+        `approach` (unit, `base`), clear of `checker`. After `leave_touches` such stops it
+        draws back unguarded. A spice jar let go 1 cm off the hand's middle, its top
+        between the pads, was dragged over by a pad's 0.2-1.2 N as the hand drew back."""
+        b = self.settings.behaviour
+        for _ in range(b.leave_touches):
+            guard = pad_force(self.robot) + b.leave_nudge
+            failure = self.run_withdrawal(back, guard=guard)
+            if failure is None or "unexpected contact" not in failure.message:
+                return failure
+            self._slide_pads_off()
+            again = self.withdrawal_path(approach, checker, level=False)
+            if again is None:  # eased where no way back is clear: on along the first one
+                q = self.current_q()
+                return self.run_withdrawal(np.vstack([q, back[_nearest(back, q) + 1 :]]))
+            back = again
+        return self.run_withdrawal(back)
 
     def _rise_to(self, height: float, checker: CollisionChecker) -> None:
         """Rise straight up to `height` (m, `base` z of the TCP), at the approach speed, if
@@ -184,3 +207,8 @@ class Leaving(Withdrawing):
         self.robot.sleep(b.leave_settle)  # the servos lag the trajectory's clock
         if met is not None:
             self.rise_straight(start, "rising off what the fingers met")
+
+
+def _nearest(path: np.ndarray, q: np.ndarray) -> int:
+    """The index of the configuration of `path` (N, 6) rad nearest to q (6,)."""
+    return int(np.argmin(np.max(np.abs(path - q), axis=1)))

@@ -13,7 +13,7 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.transforms import rotz
-from laserpick.types import Failure
+from laserpick.types import Failure, Trajectory
 
 __all__ = ["Withdrawing"]
 
@@ -22,12 +22,18 @@ class Withdrawing(GuardedMotion):
     """The hand drawn back along its approach: the way found (`withdrawal_path`), then run
     (`run_withdrawal`)."""
 
-    def run_withdrawal(self, path: np.ndarray, speed: float | None = None) -> Failure | None:
+    def run_withdrawal(
+        self, path: np.ndarray, speed: float | None = None, *, guard: float | None = None
+    ) -> Failure | None:
         """Run a way back (N, 6) that `withdrawal_path` found, at TCP `speed` (m/s; default:
-        the approach's)."""
+        the approach's); with a `guard` (N), stopped where the hand feels more than it (the
+        failure then says "unexpected contact")."""
         s = self.settings.motion
         speed = s.approach_speed if speed is None else speed
-        return self.run(timed(path, s, tcp_speed=speed), "drawing back")
+        back = timed(path, s, tcp_speed=speed)
+        if guard is not None:
+            back = Trajectory(back.times, back.q, guard_force=guard)
+        return self.run(back, "drawing back")
 
     def withdrawal_path(
         self,

@@ -210,6 +210,13 @@ class BehaviourSettings(BaseModel):
         " way and, where the pads still feel something, the other: risen straight up, a"
         " hand took a pill bottle that leaned on one pad by its cap's lip up with it. Ours.",
     )
+    leave_touches: int = Field(
+        2,
+        ge=0,
+        description="How often the open hand drawing back from what it set down may stop"
+        " where a pad touches it (`leave_nudge`) and ease the pads off sideways, before it"
+        " draws back unguarded. Ours.",
+    )
     leave_nudge: float = Field(
         0.5,
         gt=0,

@@ -30,6 +30,15 @@ PAD_CONTACT = {
     "solimp": [0.95, 0.99, 0.001, 0.5, 2.0],
     "priority": 1,
 }
+#: The housing's and the finger plates' contact: as stiff as the pads' (aluminium does not
+#: give), their stiffness winning the mix with what they touch (`solmix`) while friction and
+#: contact dimensions stay the larger of the two. With MuJoCo's default softness a spice jar
+#: squeezed against the palm sank 15 mm into it while carried, and sprang out when let go.
+HAND_CONTACT = {
+    "solref": PAD_CONTACT["solref"],
+    "solimp": PAD_CONTACT["solimp"],
+    "solmix": 1000.0,
+}
 
 
 def add_gripper(flange: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
@@ -37,7 +46,7 @@ def add_gripper(flange: mujoco.MjsBody, fingers_move: bool) -> mujoco.MjsBody:
     g = flange.add_body(name="gripper", pos=[0, 0, 0])
     g.gravcomp = 1.0
     for shape in PARTS_BY_NAME[g.name].shapes:
-        add_shape(g, shape, mass=GEOM_MASS[shape.name], **ARM_GEOM)
+        add_shape(g, shape, mass=GEOM_MASS[shape.name], **ARM_GEOM, **HAND_CONTACT)
     g.add_site(name=TCP_SITE, pos=[0, 0, dims.GRIPPER_TCP_OFFSET], size=[0.006, 0, 0], group=5)
     for side, sign in (("left", 1.0), ("right", -1.0)):
         _add_finger(g, side, sign, fingers_move)
@@ -60,5 +69,5 @@ def _add_finger(g: mujoco.MjsBody, side: str, sign: float, fingers_move: bool) -
         # The kinematic model holds the fingers fully open.
         part = finger(side, travel=dims.GRIPPER_STROKE / 2)
     plate, pad = part.shapes
-    add_shape(f, plate, mass=GEOM_MASS[plate.name], **ARM_GEOM)
+    add_shape(f, plate, mass=GEOM_MASS[plate.name], **ARM_GEOM, **HAND_CONTACT)
     add_shape(f, pad, mass=GEOM_MASS[pad.name], **ARM_GEOM, **PAD_CONTACT)
