@@ -334,3 +334,39 @@ def test_let_go_low_on_the_floor_the_open_hand_is_drawn_back_off_a_tall_box():
         moves.clear()
         assert b.leave_object(above, free) is None
         assert moves == ["rising from the object"]
+
+
+def test_an_open_hand_drawing_back_stops_where_a_pad_touches_and_eases_off():
+    """Drawn back from a spice jar it let go of 1 cm off its middle, a pad brushed the jar's
+    top and dragged it over. The draw-back after a place is guarded (`leave_nudge` over
+    what the pads bear): where a pad touches what it let go of, the hand stops, eases the
+    pads off it sideways and draws back from there along its approach. Here the way back
+    given also runs 8 cm across (-y), and the hand stands 1.9 cm to the jar's -y, so that
+    the +y pad, 1 mm from the jar's top, meets it at once. Drawn back that way unguarded
+    (`leave_touches` 0), the pad tipped the jar over."""
+    with scene_robot(str(DATA / "jar_table.yaml")) as robot:
+        referee = Referee(robot)
+        jar = referee.position("spice_jar_1")
+        b = Behaviours(robot)
+        s = b.settings.motion
+        z = jar[2] + 0.08  # the pads about the jar's top, as a side grasp from a shelf
+        top = np.mgrid[1.65:2.25:0.02, -0.65:0.35:0.02].reshape(2, -1).T
+        table = CollisionChecker(np.c_[top, np.full(len(top), jar[2])], margin=0.0)
+        out_front = side_pose(jar[0] - 0.10, jar[1], z)
+        q = next(q for q in ik_tcp(out_front, dims.UR5_READY_Q) if table.clearance_ok(q)[0])
+        assert b.go_to(q, table, "test").ok
+        y = jar[1] - 0.019
+        about = cartesian_line(robot.joint_state().q, side_pose(jar[0], y, z))
+        assert about is not None and b.run(timed(about, s, tcp_speed=0.03), "test") is None
+        robot.sleep(0.5)
+        assert robot.gripper_state().force <= BEHAVIOUR.pads_clear, "the pads touch nothing"
+        across = cartesian_line(robot.joint_state().q, side_pose(jar[0] - 0.10, y - 0.08, z))
+        assert across is not None
+        moves = recorded_moves(b)
+        assert b._draw_back_by_touch(across, side_pose(0, 0, 0)[:3, 2], table) is None
+        assert moves[:2] == ["drawing back", "easing the pads off"], moves
+        assert moves[-1] == "drawing back"
+        end = tcp_pose(robot.joint_state().q)[:3, 3]
+        assert end[0] < jar[0] - 0.08, "drawn back off the jar"
+        robot.sleep(1.0)
+        assert np.linalg.norm(referee.position("spice_jar_1") - jar) < 0.003, "left standing"
