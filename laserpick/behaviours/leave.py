@@ -88,7 +88,7 @@ class Leaving(Withdrawing):
         the pads off it sideways (`_slide_pads_off`) and draws back from there along its
         `approach` (unit, `base`), clear of `checker`. After `leave_touches` such stops it
         draws back unguarded. A spice jar let go 1 cm off the hand's middle, its top
-        between the pads, was dragged over by a pad's 0.2-1.2 N as the hand drew back."""
+        between the pads, was dragged over by a pad's 0.04-1.2 N as the hand drew back."""
         b = self.settings.behaviour
         for _ in range(b.leave_touches):
             guard = pad_force(self.robot) + b.leave_nudge
@@ -99,7 +99,8 @@ class Leaving(Withdrawing):
             again = self.withdrawal_path(approach, checker, level=False)
             if again is None:  # eased where no way back is clear: on along the first one
                 q = self.current_q()
-                return self.run_withdrawal(np.vstack([q, back[_nearest(back, q) + 1 :]]))
+                rest = back[_nearest(back, q) + 1 :]
+                return self.run_withdrawal(np.vstack([q, rest])) if len(rest) else None
             back = again
         return self.run_withdrawal(back)
 
