@@ -28,9 +28,15 @@ from laserpick.robot.interface import PROTECTIVE_STOP, Robot
 from laserpick.settings import Settings, get_settings
 from laserpick.types import Failure, Trajectory
 
-__all__ = ["GuardedMotion"]
+__all__ = ["GuardedMotion", "nearest_on"]
 
 log = logging.getLogger(__name__)
+
+
+def nearest_on(path: np.ndarray, q: np.ndarray) -> int:
+    """The index of the configuration of `path` (N, 6) rad nearest to q (6,), by the largest
+    joint difference: where on a trajectory the arm stands."""
+    return int(np.argmin(np.max(np.abs(path - q), axis=1)))
 
 
 class GuardedMotion:
@@ -117,7 +123,7 @@ class GuardedMotion:
             return False
         b = self.settings.behaviour
         q = self.current_q()
-        reached = int(np.argmin(np.max(np.abs(traj.q - q), axis=1)))
+        reached = nearest_on(traj.q, q)
         back = np.vstack([q, traj.q[reached::-1]])
         # Keep the turning points, about back_step apart: a trajectory is sampled densely.
         moved = np.concatenate([[0.0], np.cumsum(np.max(np.abs(np.diff(back, axis=0)), axis=1))])

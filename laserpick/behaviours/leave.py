@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from laserpick.behaviours.guarded_motion import nearest_on
 from laserpick.behaviours.hand import pad_force, peak_pad_force
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
@@ -99,7 +100,7 @@ class Leaving(Withdrawing):
             again = self.withdrawal_path(approach, checker, level=False)
             if again is None:  # eased where no way back is clear: on along the first one
                 q = self.current_q()
-                rest = back[_nearest(back, q) + 1 :]
+                rest = back[nearest_on(back, q) + 1 :]
                 return self.run_withdrawal(np.vstack([q, rest])) if len(rest) else None
             back = again
         return self.run_withdrawal(back)
@@ -208,8 +209,3 @@ class Leaving(Withdrawing):
         self.robot.sleep(b.leave_settle)  # the servos lag the trajectory's clock
         if met is not None:
             self.rise_straight(start, "rising off what the fingers met")
-
-
-def _nearest(path: np.ndarray, q: np.ndarray) -> int:
-    """The index of the configuration of `path` (N, 6) rad nearest to q (6,)."""
-    return int(np.argmin(np.max(np.abs(path - q), axis=1)))
