@@ -34,6 +34,7 @@ STAGES = (
     "deepest_tips",
     "closing_region",
     "recentre",
+    "square",
     "total",
 )
 TYPICAL = (1000, 3000)  #: target sizes (points) of a typical segmented household object

@@ -100,9 +100,9 @@ def test_voxel_groups_hold_each_point_once_within_its_radius():
 def test_detector_equals_the_direct_computation():
     # detect_grasps' shortcuts (the antipodal bound, voxel-pruned collisions, the cropped and
     # de-duplicated scene) change nothing: the same grasps as deepest_tips over every frame
-    # and every (sample, scene point) pair, then the antipodal test. Without re-centring,
-    # which test_off_centre_hands_are_turned_and_shifted_onto_their_patch covers.
-    given = GraspSettings(gpd_samples=200, gpd_recentre=0.0)
+    # and every (sample, scene point) pair, then the antipodal test. Without re-centring and
+    # squaring, which test_grasp_detect covers.
+    given = GraspSettings(gpd_samples=200, gpd_recentre=0.0, gpd_square=False)
     pts, n = cylinder()
     other, _ = box((0.04, 0.04, 0.10), centre=(0.06, 0.0))
     normals, target = noisy(n), pts.astype(np.float32).astype(np.float64)

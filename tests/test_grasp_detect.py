@@ -192,6 +192,34 @@ def test_recentring_adds_centred_hands_after_the_first():
     assert sum(g.pads_centred for g in above) >= 2 * n_first
 
 
+def slant_about_approach(g: Grasp) -> float:
+    """Degrees between a grasp's closing axis and the nearest face normal of a box whose
+    faces lie along `base`'s axes, seen along its approach."""
+    k = int(np.argmax(np.abs(g.closing)))
+    face = np.eye(3)[k] * np.sign(g.closing[k])
+    return abs(math.degrees(math.atan2(face @ g.axis, face @ g.closing)))
+
+
+@pytest.mark.parametrize("size", [(0.106, 0.054, 0.025), (0.05, 0.03, 0.10)])
+def test_hands_on_a_box_are_turned_square_to_its_sides(size):
+    """A flat face gives the curvature axis no direction, so GPD's hands come onto a box
+    turned any way about their approach, and the friction cone passes pads up to 20 degrees
+    off its sides: they hold it on two diagonal edges. Each is replaced by the hand turned
+    square to the faces its pads meet, where that one passes."""
+    pts, n = box(size)
+    plain = [
+        detect(pts, n, seed=k, settings=S.model_copy(update={"gpd_square": False}))
+        for k in range(3)
+    ]
+    square = [detect(pts, n, seed=k) for k in range(3)]
+    assert [len(g) for g in square] == [len(g) for g in plain]
+    before = [slant_about_approach(g) for gs in plain for g in gs]
+    after = [slant_about_approach(g) for gs in square for g in gs]
+    assert max(before) > 6.0
+    assert max(after) < 3.0
+    assert all(0 < g.width <= HAND.width_max for gs in square for g in gs)
+
+
 def test_tilted_frames_lean_the_normal_toward_the_axis_about_the_closing_axis():
     rng = np.random.default_rng(4)
     normal = rng.normal(size=(5, 3))

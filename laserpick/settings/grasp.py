@@ -142,6 +142,12 @@ class GraspSettings(BaseModel):
         " it is tried again turned about its axis and moved along it onto that patch"
         " (gpd.recentre.patch_moves). 0 turns this off. Ours: one pad width.",
     )
+    gpd_square: bool = Field(
+        True,
+        description="Turn each hand whose pads meet the object's faces at a slant about its"
+        " approach square to them (gpd.square): pads on a box's sides at a slant hold it on"
+        " two diagonal edges, about which it turns while carried. Ours.",
+    )
     gpd_collision_voxel: float = Field(
         0.0,
         ge=0,

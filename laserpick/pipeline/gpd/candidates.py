@@ -33,3 +33,21 @@ class HandCandidates:
         """The candidates `keep` (indices) of these."""
         per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
         return replace(self, **{k: getattr(self, k)[keep] for k in per})
+
+    def with_replaced(
+        self, at: np.ndarray, other: HandCandidates, which: np.ndarray
+    ) -> HandCandidates:
+        """These candidates with those at `at` (indices) replaced by `other`'s `which`
+        (indices, one for each), in place: their frames are appended to these."""
+        n = len(self.samples)
+        out = {
+            "samples": np.vstack([self.samples, other.samples]),
+            "normal": np.vstack([self.normal, other.normal]),
+            "axis": np.vstack([self.axis, other.axis]),
+        }
+        per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
+        for k in per:
+            mine, theirs = getattr(self, k).copy(), getattr(other, k)[which]
+            mine[at] = theirs + n if k == "sample" else theirs
+            out[k] = mine
+        return replace(self, **out)

@@ -25,6 +25,7 @@ from laserpick.pipeline.gpd.frames import (
 from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
 from laserpick.pipeline.gpd.neighbourhoods import collision_cloud
 from laserpick.pipeline.gpd.recentre import patch_moves
+from laserpick.pipeline.gpd.square import square_turns, turned_frames
 from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, pruned_tips
 from laserpick.settings import GraspSettings, get_settings
 from laserpick.types import Grasp
@@ -48,8 +49,10 @@ def detect_grasps(
     the sampling: the same seed gives the same grasps. Returns grasps with pose (TCP in
     `base`; columns hand axis, closing axis, approach) and width (m), in sample order, then
     the hands moved onto their patches (`CandidateSearch.recentred`). timings, if given,
-    receives the seconds spent in each stage (bench/grasp_detect_speed.py; the second pass
-    adds to the first's stages). tilts (rad): each sample's frame is tried turned about its
+    receives the seconds spent in each stage (bench/grasp_detect_speed.py; the later passes
+    add to the first's stages). Each hand whose pads meet the object's faces at a slant
+    about its approach is replaced by the hand turned square to them, where that one passes
+    (`CandidateSearch.squared`). tilts (rad): each sample's frame is tried turned about its
     closing axis by each of these (`tilted_frames`); the default, no tilt, is GPD's.
     guessed: (M,) bool, the target points that were guessed (`mirrored_back`) rather than
     seen; see `guesses_face_seen`.
@@ -76,7 +79,8 @@ def detect_grasps(
     lap("frames")
     search = CandidateSearch(tgt, normals, scene, centre, tree, hand, s, guessed, lap)
     first = search.candidates(samples, normal, axis)
-    grasps = as_grasps((first, search.recentred(first)), centre)
+    passes = (first, search.recentred(first))
+    grasps = as_grasps(tuple(search.squared(found) for found in passes), centre)
     if timings is not None:
         timings["total"] = time.perf_counter() - lap.start
     return grasps
@@ -246,3 +250,18 @@ class CandidateSearch:
             only=found.orientation[off[moved]],
         )
         return again.subset(np.flatnonzero(again.centred))
+
+    def squared(self, found: HandCandidates) -> HandCandidates:
+        """`found`, each hand whose pads meet the object's faces at a slant about its
+        approach (`square_turns`) replaced by that hand turned square to them and tested
+        again from scratch, where it passes, and is centred if the first was. Ours, beyond
+        GPD (see square.py)."""
+        turn = square_turns(self.tgt, self.normals, self.hand, self.s, found)
+        moved = np.flatnonzero(np.isfinite(turn))
+        self.lap("square")
+        if not len(moved):
+            return found
+        samples, normal, axis = turned_frames(found.subset(moved), turn[moved])
+        again = self.candidates(samples, normal, axis, only=found.orientation[moved])
+        keep = np.flatnonzero(again.centred | ~found.centred[moved[again.sample]])
+        return found.with_replaced(moved[again.sample[keep]], again, keep)

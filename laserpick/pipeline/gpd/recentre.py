@@ -72,9 +72,10 @@ def patch_moves(
 
 
 class WideSlab:
-    """The target points in a slab gpd_recentre wider on each side of the pads of each of
-    `found`'s hands, as slab_pairs gives them: f (P,) the hand, h, u, v (P,) coordinates (m)
-    and nu, nv (P,) the normals' components, in its sample's frame."""
+    """The target points in a slab `margin` (m; default gpd_recentre) wider on each side of
+    the pads of each of `found`'s hands, as slab_pairs gives them: f (P,) the hand, p (P,)
+    the point, h, u, v (P,) coordinates (m) and nu, nv (P,) the normals' components, in its
+    sample's frame."""
 
     def __init__(
         self,
@@ -83,16 +84,18 @@ class WideSlab:
         hand: HandGeometry,
         s: GraspSettings,
         found: HandCandidates,
+        margin: float | None = None,
     ) -> None:
         i = found.sample
+        margin = s.gpd_recentre if margin is None else margin
         region = [
             (
-                hand.pad_width / 2 + s.gpd_recentre,
+                hand.pad_width / 2 + margin,
                 math.hypot(hand.width_max, hand.finger_length),
                 np.inf,
             )
         ]
-        self.f, _, self.h, self.u, self.v, self.nu, self.nv = slab_pairs(
+        self.f, self.p, self.h, self.u, self.v, self.nu, self.nv = slab_pairs(
             tgt, found.samples[i], found.normal[i], found.axis[i], region, normals
         )
         self.found, self.hand, self.band = found, hand, s.gpd_contact_band
@@ -115,6 +118,12 @@ class WideSlab:
         left = inside & (cc >= cmax.take(f) - self.band)
         right = inside & (cc <= cmin.take(f) + self.band)
         return left, right, st * nu - ct * nv, ct * nu + st * nv
+
+    def along_hand_axis(self, vectors: np.ndarray) -> np.ndarray:
+        """(P,) each pair's point's vector (`vectors` (N, 3), e.g. the normals) along its
+        hand's axis."""
+        axes = self.found.axis.take(self.found.sample.take(self.f), axis=0)
+        return np.einsum("pi,pi->p", np.take(vectors, self.p, axis=0), axes)
 
     def medians(self, on: np.ndarray, x: np.ndarray) -> np.ndarray:
         """(G,) the median of `x` over each hand's pairs `on`; NaN for a hand with none."""
