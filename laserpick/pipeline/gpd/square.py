@@ -7,7 +7,8 @@ gives hands turned any way about the approach, and the antipodal test passes tho
 closing axis lies within the friction cone of the faces' normals. Such pads meet a box's
 sides on two diagonal edges, and the box turns slowly about them. Held in the simulation
 for a minute, a TV remote turned 0.6 degrees with the pads square to it, 4 with them 6
-degrees off it and 7 with them 9 degrees off; a tissue packet 2.6, 8 and 8.
+degrees off it and 7 with them 9 degrees off; a tissue packet 2.6, 8 and 8
+(`bench/slanted_pads_hold.py`).
 """
 
 from __future__ import annotations
