@@ -40,7 +40,8 @@ Modules: `frames` (samples, local frames, orientations), `neighbourhoods` (point
 sample, in its frame), `closing_grid` (the hand's depth per placement, directly),
 `voxel_pruning` (the same, bounded with voxels), `antipodal` (the closing region and the
 antipodal test), `hand` (the cleared hand, its regions and poses), `candidates` (what passed),
-`recentre` (the second pass), `detector` (`detect_grasps`).
+`recentre` (the second pass), `square` (the last: pads square to the faces they meet),
+`detector` (`detect_grasps`).
 """
 
 from laserpick.pipeline.gpd.candidates import HandCandidates

@@ -1,7 +1,8 @@
 """The detector: sample the target, build a local frame at each sample, rotate and slide
 the hand there, push it in until just before contact, and keep the collision-free hands
 whose pads close antipodally on the object; then move the hands that are not centred onto
-their patches and test them again. Frames: `base` (x forward, y left, z up), metres.
+their patches, turn those whose pads meet the object's faces at a slant square to them, and
+test them again. Frames: `base` (x forward, y left, z up), metres.
 """
 
 from __future__ import annotations
