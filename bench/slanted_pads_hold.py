@@ -21,33 +21,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import test_grasp_physics as scripted  # the tests' scripted grasp
 
-SQUARE_GRASP = scripted._top_down_grasp
-
-
-def _turned_grasp(slant: float):
-    """The scripted top-down grasp turned by `slant` rad about its approach."""
-
-    def grasp(p, q, model):
-        T = SQUARE_GRASP(p, q, model)
-        c, s = math.cos(slant), math.sin(slant)
-        T[:3, :3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ T[:3, :3]
-        return T
-
-    return grasp
+from laserpick.transforms import rotation_angle
 
 
 def held_drift(name: str, slant_deg: float, hold: float) -> tuple[float, float, float, bool]:
     """(finger gap mm, moved mm, turned deg, still holding) of `name` held `hold` s with the
     pads `slant_deg` off its sides."""
-    scripted._top_down_grasp = _turned_grasp(math.radians(slant_deg))
-    sim, body, q_grasp, q_lift = scripted._at_grasp(name)
-    sim.gripper(True)
-    sim.settle(1.0)
-    h = sim.execute(scripted._joint_path(q_grasp, q_lift, 0.3))
-    sim.run_until(h, 10.0)
-    sim.settle(0.5)
-    m, d = sim.model, sim.data
-    tcp = next(i for i in range(m.nsite) if m.site(i).name.endswith("tcp"))
+    sim, body, q_grasp, q_lift = scripted._at_grasp(name, turn=math.radians(slant_deg))
+    scripted._close_and_lift(sim, q_grasp, q_lift)
+    d, tcp = sim.data, sim.info.tcp_site
 
     def in_hand() -> tuple[np.ndarray, np.ndarray]:
         R = d.site_xmat[tcp].reshape(3, 3)
@@ -57,7 +39,7 @@ def held_drift(name: str, slant_deg: float, hold: float) -> tuple[float, float, 
     gap = sim.snapshot().gripper_width
     sim.settle(hold)
     p1, R1 = in_hand()
-    turned = math.degrees(math.acos(np.clip((np.trace(R0.T @ R1) - 1) / 2, -1.0, 1.0)))
+    turned = math.degrees(rotation_angle(R0, R1))
     return gap * 1000, float(np.linalg.norm(p1 - p0)) * 1000, turned, sim.snapshot().holding
 
 

@@ -19,7 +19,7 @@ from laserpick.robot.sim.loop import Simulation
 from laserpick.robot.sim.objects import LIBRARY, min_width, support
 from laserpick.robot.sim.scenes import parse_scene
 from laserpick.settings import get_settings
-from laserpick.transforms import invert, matrix_from_quat, planar_pose
+from laserpick.transforms import invert, matrix_from_quat, planar_pose, rotz
 from laserpick.types import Trajectory
 
 MOTION = get_settings().motion
@@ -98,9 +98,10 @@ def _ik(T: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
     return sols[0]
 
 
-def _at_grasp(name: str) -> tuple[Simulation, int, np.ndarray, np.ndarray]:
+def _at_grasp(name: str, turn: float = 0.0) -> tuple[Simulation, int, np.ndarray, np.ndarray]:
     """A simulation with the open hand around `name`, ready to close: the simulation, the
-    object's body id, and the arm's grasp and lift configurations (rad)."""
+    object's body id, and the arm's grasp and lift configurations (rad). turn: the grasp
+    turned by this (rad) about its approach, off the object's sides."""
     model = LIBRARY[name]
     assert min_width(model) <= dims.GRIPPER_STROKE
     sim = Simulation(parse_scene(_scene_text(name)), realtime=False)
@@ -113,6 +114,7 @@ def _at_grasp(name: str) -> tuple[Simulation, int, np.ndarray, np.ndarray]:
     q_obj = s.xquat[body]  # the scooter starts unrotated, so world and base share axes
 
     grasp = _top_down_grasp(p_obj, q_obj, model)
+    grasp[:3, :3] = rotz(turn) @ grasp[:3, :3]  # the approach is straight down
     pre = grasp.copy()
     pre[2, 3] += 0.12
     lift = grasp.copy()
@@ -129,15 +131,20 @@ def _at_grasp(name: str) -> tuple[Simulation, int, np.ndarray, np.ndarray]:
     return sim, body, q_grasp, q_lift
 
 
-@pytest.mark.parametrize("name", GRASPED)
-def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
-    sim, body, q_grasp, q_lift = _at_grasp(name)
-    z_rest = sim.snapshot().xpos[body][2]
+def _close_and_lift(sim: Simulation, q_grasp: np.ndarray, q_lift: np.ndarray) -> None:
+    """Close the hand at q_grasp, lift to q_lift (rad) and let the object settle."""
     sim.gripper(True)
     sim.settle(1.0)
     h = sim.execute(_joint_path(q_grasp, q_lift, 0.3))
     assert sim.run_until(h, 10.0) == "done", h.message
     sim.settle(0.5)
+
+
+@pytest.mark.parametrize("name", GRASPED)
+def test_top_down_grasp_lifts_10cm_and_holds_5s(name):
+    sim, body, q_grasp, q_lift = _at_grasp(name)
+    z_rest = sim.snapshot().xpos[body][2]
+    _close_and_lift(sim, q_grasp, q_lift)
     z_lifted = sim.snapshot().xpos[body][2]
     sim.settle(5.0)
 

@@ -6,6 +6,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+#: HandCandidates' fields that hold one entry per hand (the others hold one per frame).
+PER_HAND = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
+
 
 @dataclass(frozen=True)
 class HandCandidates:
@@ -31,8 +34,7 @@ class HandCandidates:
 
     def subset(self, keep: np.ndarray) -> HandCandidates:
         """The candidates `keep` (indices) of these."""
-        per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
-        return replace(self, **{k: getattr(self, k)[keep] for k in per})
+        return replace(self, **{k: getattr(self, k)[keep] for k in PER_HAND})
 
     def with_replaced(
         self, at: np.ndarray, other: HandCandidates, which: np.ndarray
@@ -45,8 +47,7 @@ class HandCandidates:
             "normal": np.vstack([self.normal, other.normal]),
             "axis": np.vstack([self.axis, other.axis]),
         }
-        per = ("sample", "orientation", "offset", "tip", "width", "centred", "poses")
-        for k in per:
+        for k in PER_HAND:
             mine, theirs = getattr(self, k).copy(), getattr(other, k)[which]
             mine[at] = theirs + n if k == "sample" else theirs
             out[k] = mine
