@@ -173,7 +173,7 @@ def main() -> None:
         )
     print(
         "frames: sampling and local frames; pad_pairs: the pads' contents and the antipodal"
-        " bound; crop: the scene around the target; collision_pairs + deepest_tips:"
+        " bound; crop: the scene around the target, in voxels; collision_pairs + deepest_tips:"
         " hand-vs-scene collisions; closing_region: the antipodal test."
     )
 

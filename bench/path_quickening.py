@@ -61,7 +61,7 @@ def main() -> None:
         t = time.perf_counter()
         quick = joint_search.joint_path(q0, q1, checker, np.random.default_rng(0), s, **kw)
         t_quick = time.perf_counter() - t
-        clear = functools.partial(checker.clearance_ok, **kw)  # as the arm's timing blends
+        clear = functools.partial(checker.path_clear, **kw)  # as the arm's timing blends
         before = timed(searched, s, carrying=carry, clear=clear).duration
         after = timed(quick, s, carrying=carry, clear=clear).duration
         rows.append((before, after, t_searched, t_quick))

@@ -22,7 +22,12 @@ from laserpick.pipeline.gpd.frames import (
 )
 from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
 from laserpick.pipeline.gpd.neighbourhoods import VoxelGroups, slab_pairs
-from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, RangeMax, pruned_tips
+from laserpick.pipeline.gpd.voxel_pruning import (
+    COLLISION_VOXEL,
+    CoarsePairs,
+    RangeMax,
+    pruned_tips,
+)
 from laserpick.settings import GraspSettings
 
 S = GraspSettings()
@@ -45,7 +50,7 @@ def test_pruned_tips_equal_the_direct_computation():
     sid, _, h, u, v = slab_pairs(cloud, samples, normal, axis, regions)
     direct = deepest_tips(h, u, v, sid, len(samples), angles, grid, HAND, S)
     want = np.random.default_rng(2).random(direct.shape[:2]) < 0.7
-    pairs = CoarsePairs(cloud, samples, normal, axis, regions)
+    pairs = CoarsePairs(VoxelGroups(cloud, COLLISION_VOXEL), samples, normal, axis, regions)
     pruned = pruned_tips(pairs, samples, normal, axis, angles, grid, HAND, S, regions, want)
     free = np.isfinite(direct) & want[:, :, None]
     assert free.sum() > 500 and (~free & want[:, :, None]).sum() > 500  # both kinds occur

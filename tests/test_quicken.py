@@ -61,7 +61,7 @@ def test_no_change_is_kept_that_the_check_refuses():
         rng = np.random.default_rng(seed)
         found = rrt_connect(detour[0], detour[-1], checker, rng, step=s.rrt_step)
         searched = shortcut(found, checker, rng)
-        runs, searched_runs = (timed(p, s, clear=checker.clearance_ok) for p in (path, searched))
+        runs, searched_runs = (timed(p, s, clear=checker.path_clear) for p in (path, searched))
         assert runs.duration <= searched_runs.duration
         saved += searched_runs.duration - runs.duration
     assert saved > 0.3  # 0.66 s over the three seeds, as the arm runs them
@@ -87,7 +87,7 @@ def test_short_legs_go_and_the_arm_runs_the_path_sooner():
     assert len(out) < len(path)
     assert (np.linalg.norm(np.diff(out, axis=0), axis=1) >= 0.5).all()
     assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(out))
-    clear = checker.clearance_ok
+    clear = checker.path_clear
     assert timed(out, s, clear=clear).duration < timed(path, s, clear=clear).duration - 0.3
 
 

@@ -81,7 +81,7 @@ def test_a_sharp_corner_is_blended_without_a_velocity_jump() -> None:
 def test_a_checked_corner_is_cut_wider_and_sooner() -> None:
     """Where the check passes every configuration, the blend may stray up to the checked
     tolerance: the arm keeps its speed round the corner instead of nearly stopping."""
-    everywhere = lambda Q: np.ones(len(Q), bool)  # noqa: E731
+    everywhere = lambda Q: True  # noqa: E731
     tight = time_parametrize(CORNER, limits=LIMITS, tolerance=TOL)
     wide = time_parametrize(
         CORNER, limits=LIMITS, tolerance=TOL, checked_tolerance=0.3, clear=everywhere
@@ -96,14 +96,14 @@ def test_a_blend_keeps_out_of_what_its_check_refuses() -> None:
     """The inside of the corner is blocked from 0.1 rad off the legs: the blend shrinks until
     every configuration along it passes the check, and the trajectory keeps out."""
 
-    def clear(Q: np.ndarray) -> np.ndarray:
+    def free(Q: np.ndarray) -> np.ndarray:
         return ~((Q[:, 0] < 0.9) & (Q[:, 1] > 0.1))
 
     traj = time_parametrize(
-        CORNER, limits=LIMITS, tolerance=TOL, checked_tolerance=0.3, clear=clear
+        CORNER, limits=LIMITS, tolerance=TOL, checked_tolerance=0.3, clear=lambda Q: free(Q).all()
     )
     _assert_smooth_within(traj, LIMITS)
-    assert clear(traj.q).all()
+    assert free(traj.q).all()
     assert _off_polyline(traj.q, CORNER).max() > 2 * TOL  # still cut wider than unchecked
 
 

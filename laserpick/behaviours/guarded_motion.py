@@ -175,7 +175,7 @@ class GuardedMotion:
         check it was searched with (`checker`, kw) passes, within the carrying limits where
         kw has a `payload`."""
         carrying = kw.get("payload") is not None
-        clear = functools.partial(checker.clearance_ok, **kw)  # the legs' search's own check
+        clear = functools.partial(checker.path_clear, **kw)  # the legs' search's own check
         return self.run(timed(path, self.settings.motion, carrying=carrying, clear=clear), what)
 
     def descend(

@@ -82,7 +82,7 @@ def joint_path(
         return path  # nothing was shortened: no timing to compare (a fifth of isolation's)
     # The estimate `quicken` goes by leaves out the corners; the arm's own timing decides,
     # its corners blended where this search's check passes (`GuardedMotion.follow`).
-    clear = functools.partial(checker.clearance_ok, **kw)
+    clear = functools.partial(checker.path_clear, **kw)
     return min((path, quick), key=lambda p: timed(p, s, carrying=carrying, clear=clear).duration)
 
 

@@ -173,7 +173,7 @@ def way_to(
 def _leg_check(world: CollisionChecker, a: np.ndarray, b: np.ndarray, seen: bool) -> ClearFn:
     """The check `Searches.path` searched the leg from a to b with, for configurations."""
     known = world.knowing(a, b) if seen else world
-    return lambda Q: known.clearance_ok(Q, hand=True, seen=seen)
+    return lambda Q: known.path_clear(Q, hand=True, seen=seen)
 
 
 def plan_pick(

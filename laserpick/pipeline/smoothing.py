@@ -33,8 +33,8 @@ from scipy.interpolate import BPoly
 
 __all__ = ["BlendedPath", "ClearFn", "Corners", "corners"]
 
-#: Configurations (B, 6) rad -> (B,) whether each is clear.
-ClearFn = Callable[[np.ndarray], np.ndarray]
+#: Configurations (B, 6) rad along a path -> whether every one of them is clear.
+ClearFn = Callable[[np.ndarray], bool]
 
 #: The quintic blend's control points, as fractions of d along the incoming (negative) and
 #: outgoing (positive) leg.
@@ -178,7 +178,7 @@ def _reach(
         for _ in range(CHECK_HALVINGS + 1):
             if wide <= d:
                 break
-            if np.all(clear(_blend_samples(p, u1, u2, wide))):
+            if clear(_blend_samples(p, u1, u2, wide)):
                 d = wide
                 break
             wide /= 2.0
@@ -193,11 +193,7 @@ def _both(a: ClearFn | None, b: ClearFn | None) -> ClearFn | None:
     if a is b:
         return a
 
-    def both(Q: np.ndarray) -> np.ndarray:
-        first = a(Q)
-        return first & b(Q) if first.all() else first
-
-    return both
+    return lambda Q: a(Q) and b(Q)
 
 
 def corners(

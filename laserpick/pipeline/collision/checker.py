@@ -345,10 +345,14 @@ class CollisionChecker:
         """Whether the straight joint-space segment qa -> qb is clear, checked every `step`
         rad of the largest joint motion (0.03 rad moves a 0.9 m reach by under 3 cm)."""
         n = max(2, math.ceil(float(np.max(np.abs(qb - qa))) / step) + 1)
-        Q = np.linspace(qa, qb, n)
-        # Every SEGMENT_COARSE-th configuration first: a blocked segment (most of those a
-        # planner tries) is then rejected after an eighth of the work.
-        coarse = np.zeros(n, bool)
+        return self.path_clear(np.linspace(qa, qb, n), **kw)
+
+    def path_clear(self, Q: np.ndarray, **kw: object) -> bool:
+        """Whether every configuration of the path Q (B, 6) (rad, in order along it) is
+        clear (`clearance_ok`'s options `kw`): its every SEGMENT_COARSE-th and last first, so
+        that a blocked path (most of those a planner tries, and of the wide blends at a
+        transit's corners) is rejected after an eighth of the work."""
+        coarse = np.zeros(len(Q), bool)
         coarse[::SEGMENT_COARSE] = coarse[-1] = True
         for part in (Q[coarse], Q[~coarse]):
             if len(part) and not self.all_clear(part, **kw):

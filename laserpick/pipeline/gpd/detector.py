@@ -24,10 +24,10 @@ from laserpick.pipeline.gpd.frames import (
     tilted_frames,
 )
 from laserpick.pipeline.gpd.hand import cleared_hand, grasp_poses, hand_regions
-from laserpick.pipeline.gpd.neighbourhoods import collision_cloud
+from laserpick.pipeline.gpd.neighbourhoods import VoxelGroups, collision_cloud
 from laserpick.pipeline.gpd.recentre import patch_moves
 from laserpick.pipeline.gpd.square import square_turns, turned_frames
-from laserpick.pipeline.gpd.voxel_pruning import CoarsePairs, pruned_tips
+from laserpick.pipeline.gpd.voxel_pruning import COLLISION_VOXEL, CoarsePairs, pruned_tips
 from laserpick.settings import GraspSettings, get_settings
 from laserpick.types import Grasp
 
@@ -141,16 +141,19 @@ class CandidateSearch:
         self.angles = orientation_angles(s.gpd_orientations)
         self.grid = ClosingGrid(hand, s)
         self.regions = hand_regions(hand, s)
-        self._cloud: np.ndarray | None = None
+        self._voxels: VoxelGroups | None = None
 
-    def cloud(self) -> np.ndarray:
-        """The collision cloud (`collision_cloud`), relative to the target's centre."""
-        if self._cloud is None:
-            self._cloud = collision_cloud(
+    def voxels(self) -> VoxelGroups:
+        """The collision cloud (`collision_cloud`), relative to the target's centre, grouped
+        into COLLISION_VOXEL voxels for `pruned_tips`: made when a frame first needs it,
+        once for all the passes."""
+        if self._voxels is None:
+            cloud = collision_cloud(
                 self.scene, self.centre, self.tgt, self.tree, self.regions, self.s
             )
+            self._voxels = VoxelGroups(cloud, COLLISION_VOXEL)
             self.lap("crop")
-        return self._cloud
+        return self._voxels
 
     def candidates(
         self,
@@ -215,7 +218,9 @@ class CandidateSearch:
         live = np.flatnonzero(possible.any(axis=1))
         tips = np.full((len(samples), len(angles), len(grid.offsets)), -np.inf, np.float32)
         if len(live):
-            pairs = CoarsePairs(self.cloud(), samples[live], normal[live], axis[live], self.regions)
+            pairs = CoarsePairs(
+                self.voxels(), samples[live], normal[live], axis[live], self.regions
+            )
             self.lap("collision_pairs")
             tips[live] = pruned_tips(
                 pairs,

@@ -32,10 +32,11 @@ COLLISION_VOXEL = 0.010  #: voxel edge (m) of pruned_tips' bounds: only speed de
 
 
 class CoarsePairs:
-    """The collision cloud grouped into voxels, and each sample's nearby voxels.
+    """The collision cloud grouped into voxels (`voxels`: VoxelGroups of COLLISION_VOXEL,
+    made once for all of a target's frames), and each sample's nearby voxels.
 
-    Built with the representatives of the voxels (VoxelGroups) in place of the points, and the
-    hand regions grown by each voxel's radius, so that every (sample, point) pair of
+    Built with the representatives of the voxels in place of the points, and the hand
+    regions grown by each voxel's radius, so that every (sample, point) pair of
     slab_pairs(cloud, ..., regions) has its voxel's (sample, representative) pair here.
     sid, vid: (P,) sample and voxel indices; h, u, v: (P,) the representative's coordinates
     (m, see slab_pairs); radius: (P,) the voxel's radius (m).
@@ -43,13 +44,13 @@ class CoarsePairs:
 
     def __init__(
         self,
-        cloud: np.ndarray,
+        voxels: VoxelGroups,
         samples: np.ndarray,
         normal: np.ndarray,
         axis: np.ndarray,
         regions: list[tuple[float, float, float]],
     ) -> None:
-        self.voxels = VoxelGroups(cloud, COLLISION_VOXEL)
+        self.voxels = voxels
         grow = float(self.voxels.radius.max())
         grown = [(hs + grow, r + grow, um + grow) for hs, r, um in regions]
         reps = self.voxels.points.take(self.voxels.rep, axis=0)
