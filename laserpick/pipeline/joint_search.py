@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -52,13 +53,14 @@ def joint_path(
     checker: CollisionChecker,
     rng: np.random.Generator,
     s: MotionSettings,
+    planner: Literal["ompl", "ours"] | None = None,
     **kw,
 ) -> np.ndarray | None:
-    """A clear joint path: the straight one if clear, else RRT-Connect (`s.planner`: ours or
-    OMPL's), shortened, then, with `s.quicken_paths`, made quicker to run by partial
-    shortcuts (`quicken`) and rid of its short legs (`merge_short_legs`) where the timing
-    says so. None at once when the start or the goal is not clear: no edge can leave it,
-    and the search would spend all its samples (seconds) finding that out.
+    """A clear joint path: the straight one if clear, else RRT-Connect (`planner`, default
+    `s.planner`: ours or OMPL's), shortened, then, with `s.quicken_paths`, made quicker to
+    run by partial shortcuts (`quicken`) and rid of its short legs (`merge_short_legs`)
+    where the timing says so. None at once when the start or the goal is not clear: no edge
+    can leave it, and the search would spend all its samples (seconds) finding that out.
 
     q_goal (k, 6) rad gives goals best first: the straight move to the first that has one,
     else a search toward those that are clear (`_search`), which ends at the goal it reaches.
@@ -70,7 +72,7 @@ def joint_path(
     ends_clear = checker.clearance_ok(np.vstack([q_start, goals]), **kw)
     if not ends_clear[0] or not ends_clear[1:].any():
         return None
-    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, kw)
+    path = _search(q_start, goals[ends_clear[1:]], checker, rng, s, planner or s.planner, kw)
     if path is None or not s.quicken_paths:
         return path
     # A carry runs at the carrying limits (`GuardedMotion.follow`): so is its path quickened.
@@ -92,17 +94,18 @@ def _search(
     checker: CollisionChecker,
     rng: np.random.Generator,
     s: MotionSettings,
+    planner: Literal["ompl", "ours"],
     kw: dict,
 ) -> np.ndarray | None:
-    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first;
-    None where the search found none. Ours grows the goal side from every goal at once:
-    searched one after another, goals in a pocket spent the whole search each (a cereal
-    box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
+    """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first,
+    by `planner`; None where the search found none. Ours grows the goal side from every goal
+    at once: searched one after another, goals in a pocket spent the whole search each (a
+    cereal box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
     its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
     it searches them one after another."""
     for goal in goals:
         record_search(q_start, goal, checker, kw)
-    if s.planner == "ours":
+    if planner == "ours":
         path = rrt_connect(
             q_start, goals, checker, rng, step=s.rrt_step, max_samples=s.rrt_max_samples, **kw
         )
@@ -187,7 +190,9 @@ class Searches:
             if self.stopped:
                 return None
             known = checker.knowing(a, *np.atleast_2d(b)) if seen else checker
-            self.legs[key] = joint_path(a, b, known, rng, s, hand=True, seen=seen)
+            self.legs[key] = joint_path(
+                a, b, known, rng, s, planner=s.pick_planner, hand=True, seen=seen
+            )
             if self.legs[key] is None:
                 self.failed += 1
                 # Keyed as `legs`: searched again after `forget_failed`, still one leg.

@@ -125,6 +125,11 @@ class MotionSettings(BaseModel):
         " searches are quicker on recorded problems, but in the bench its tighter carries"
         " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
+    pick_planner: Literal["ompl", "ours"] = Field(
+        "ompl",
+        description="The search for a pick's way to its pre-grasp (`first_plan.plan_first`),"
+        " as `planner` for every other search. Ours: OMPL's.",
+    )
     quicken_paths: bool = Field(
         True,
         description="Make each searched joint path quicker to run by partial shortcuts"
