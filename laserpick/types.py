@@ -7,7 +7,7 @@ Nothing here carries simulator ground truth. Units are SI; points and poses are 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -275,6 +275,11 @@ class Trajectory:
     @property
     def duration(self) -> float:
         return float(self.times[-1])
+
+    def guarded(self, force: float | None) -> Trajectory:
+        """This trajectory as a guarded move that stops where the contact force exceeds
+        `force` (N; None: unguarded)."""
+        return replace(self, guard_force=force)
 
     def sample(self, t: float) -> np.ndarray:
         """Joint angles at time t (s), linearly interpolated and held at the ends."""

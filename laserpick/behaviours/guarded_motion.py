@@ -187,7 +187,7 @@ class GuardedMotion:
         s = self.settings.motion
         down = timed(path, s, tcp_speed=tcp_speed)
         guard = s.place_contact_force + felt
-        return self.run(Trajectory(down.times, down.q, guard_force=guard), what)
+        return self.run(down.guarded(guard), what)
 
     def rise_straight(self, T: np.ndarray, what: str) -> None:
         """Rise in a straight line to TCP pose T (4, 4, `base`) at the approach speed, if the

@@ -14,7 +14,7 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.transforms import turn_between
-from laserpick.types import Failure, Trajectory
+from laserpick.types import Failure
 
 __all__ = ["Leaving"]
 
@@ -157,7 +157,7 @@ class Leaving(Withdrawing):
         guard = pad_force(self.robot) + s.place_contact_force
         for path in (turn, turn[::-1]):
             timing = timed(path, s, tcp_speed=self.settings.behaviour.leave_speed)
-            if self.run(Trajectory(timing.times, timing.q, guard_force=guard), "tipping it off"):
+            if self.run(timing.guarded(guard), "tipping it off"):
                 return
 
     def _pads_still_pressed(self) -> bool:
@@ -185,7 +185,7 @@ class Leaving(Withdrawing):
             aside = timed(path, s, tcp_speed=b.leave_speed)
             guard = pad_force(self.robot) + b.leave_nudge
             # Stopped at the guard is how the way into the object is found: not a failure.
-            self.run(Trajectory(aside.times, aside.q, guard_force=guard), "easing the pads off")
+            self.run(aside.guarded(guard), "easing the pads off")
             if not self._pads_still_pressed():
                 break
         # Touching either way, it leaves from where it is: pushed back between, unguarded,

@@ -26,7 +26,7 @@ from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.pipeline.plan import PickPlan
 from laserpick.pipeline.reach import pregrasp_pose
-from laserpick.types import Failure, Grasp, Trajectory
+from laserpick.types import Failure, Grasp
 
 __all__ = ["Picking"]
 
@@ -144,9 +144,7 @@ class Picking(Withdrawing):
         failure = self.run(plan.transit, "moving to the grasp")
         if failure:
             return failure
-        guarded = Trajectory(
-            plan.approach.times, plan.approach.q, plan.approach.gripper, guard_force=s.guard_force
-        )
+        guarded = plan.approach.guarded(s.guard_force)
         self.progress("Approaching the object.")
         failure = self.run(guarded, "approaching the object")
         if failure and "unexpected contact" in failure.message:

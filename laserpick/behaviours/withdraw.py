@@ -13,7 +13,7 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.transforms import rotz
-from laserpick.types import Failure, Trajectory
+from laserpick.types import Failure
 
 __all__ = ["Withdrawing"]
 
@@ -30,10 +30,7 @@ class Withdrawing(GuardedMotion):
         failure then says "unexpected contact")."""
         s = self.settings.motion
         speed = s.approach_speed if speed is None else speed
-        back = timed(path, s, tcp_speed=speed)
-        if guard is not None:
-            back = Trajectory(back.times, back.q, guard_force=guard)
-        return self.run(back, "drawing back")
+        return self.run(timed(path, s, tcp_speed=speed).guarded(guard), "drawing back")
 
     def withdrawal_path(
         self,
