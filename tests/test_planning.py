@@ -13,7 +13,7 @@ from pydantic import ValidationError
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.description.shapes import body_frames
-from laserpick.pipeline import rrt
+from laserpick.pipeline import joint_search, rrt
 from laserpick.pipeline.collision import (
     SPHERES,
     CollisionChecker,
@@ -174,6 +174,22 @@ def test_joint_path_goes_around_a_wall_and_every_step_is_clear(planner):
         assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
         again = joint_path(q0, q1, checker, np.random.default_rng(seed), s)
         assert np.array_equal(path, again), "the same seed gives the same path"
+
+
+def test_a_picks_way_is_searched_with_the_pick_planner_and_other_ways_with_the_planner(
+    monkeypatch,
+):
+    """The legs of a pick's transit (`Searches.path`) go to `pick_planner`; a search asked
+    of `joint_path` alone (a carry's, a stow's) to `planner`."""
+    q0, q1, checker = _wall_between()
+    used: list[str] = []
+    search = joint_search._search
+    monkeypatch.setattr(joint_search, "_search", lambda *a: used.append(a[5]) or search(*a))
+    s = get_settings().motion.model_copy(update={"pick_planner": "ompl", "planner": "ours"})
+    rng = np.random.default_rng(0)
+    assert Searches(max_failed=6).path(q0, q1, checker, rng, s, seen=False) is not None
+    assert joint_path(q0, q1, checker, rng, s) is not None
+    assert used == ["ompl", "ours"]
 
 
 @pytest.mark.parametrize("planner", ["ompl", "ours"])
