@@ -127,8 +127,11 @@ class MotionSettings(BaseModel):
     )
     pick_planner: Literal["ompl", "ours"] = Field(
         "ompl",
-        description="The search for a pick's way to its pre-grasp (`first_plan.plan_first`),"
-        " as `planner` for every other search. Ours: OMPL's.",
+        description="The search for a pick's way to its pre-grasp (`first_plan.plan_first`);"
+        " `planner` is every other search's. Ours: OMPL's, which carries nothing there. On"
+        " eleven recorded in-situ picks its searches took 12.3 s of CPU against 22.2 s with"
+        " ours; on in-situ 7301-7310 the pick planned in 0.97 s a try against 1.14 s, one"
+        " task more done (docs/pipeline.md).",
     )
     quicken_paths: bool = Field(
         True,
