@@ -182,9 +182,9 @@ class Searches:
         seen: bool = True,
     ) -> np.ndarray | None:
         """`joint_path` from a to b (6,), or to the first reached of goals b (k, 6) rad, with
-        the hand checked, searched once per pick; seen: with the hand kept where the cameras
-        saw through (`CollisionChecker.clearance_ok`), or where it stands at either end (at
-        any of the goals)."""
+        the hand checked, searched by `s.pick_planner` once per pick; seen: with the hand
+        kept where the cameras saw through (`CollisionChecker.clearance_ok`), or where it
+        stands at either end (at any of the goals)."""
         key = (np.asarray(a, float).tobytes(), np.asarray(b, float).tobytes())
         if key not in self.legs:
             if self.stopped:
