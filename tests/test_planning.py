@@ -176,6 +176,21 @@ def test_joint_path_goes_around_a_wall_and_every_step_is_clear(planner):
         assert np.array_equal(path, again), "the same seed gives the same path"
 
 
+def test_a_path_is_clear_where_every_configuration_of_it_is():
+    """`path_clear` (coarse configurations first, stopping at the first blocked one) says
+    what `clearance_ok` of every configuration says, on paths across the wall and beside it."""
+    q0, q1, checker = _wall_between()
+    rng = np.random.default_rng(3)
+    verdicts = set()
+    for _ in range(40):
+        a, b = (q + rng.normal(0.0, 0.3, 6) for q in (q0, q1))
+        Q = np.linspace(a, b, int(rng.integers(2, 60)))
+        every = bool(checker.clearance_ok(Q).all())
+        assert checker.path_clear(Q) == every
+        verdicts.add(every)
+    assert verdicts == {True, False}
+
+
 def test_a_picks_way_is_searched_with_the_pick_planner_and_other_ways_with_the_planner(
     monkeypatch,
 ):
