@@ -120,8 +120,9 @@ class MotionSettings(BaseModel):
     )
     planner: Literal["ompl", "ours"] = Field(
         "ours",
-        description="The joint-space search: our RRT-Connect with random shortcuts, or OMPL's"
-        " RRT-Connect and path simplifier; both ask our collision check. Ours: OMPL's"
+        description="The joint-space search of every way but a pick's to its pre-grasp"
+        " (`pick_planner`): our RRT-Connect with random shortcuts, or OMPL's RRT-Connect and"
+        " path simplifier; both ask our collision check. Ours: OMPL's"
         " searches are quicker on recorded problems, but in the bench its tighter carries"
         " brought held objects against the scooter (docs/pipeline.md compares them).",
     )
