@@ -34,6 +34,7 @@ from laserpick.server.session import (
     TaskState,
     check_transition,
 )
+from laserpick.server.session.watchdog import SILENT_REASON
 from laserpick.types import Failure
 
 
@@ -582,5 +583,29 @@ def test_the_dead_man_is_reckoned_from_the_last_sign_of_life_never_from_now() ->
         assert max(ahead) <= heard + limit + 0.005
         assert session.message == "The controller went silent: motion halted."
         assert np.max(np.abs(session.robot.state().base_velocity)) < 0.01
+    finally:
+        session.close()
+
+
+def test_the_watchdog_says_why_before_it_halts_the_job() -> None:
+    """A job whose motion the watchdog halts sees the halt at once and winds down with
+    whatever reason it then reads: the reason and the cancel are set before the arm is
+    halted, never after (the job would report the bare "halted")."""
+    session = Session(SimRobot(load_scene("isolation", seed=1), realtime=True))
+    seen: list[tuple[bool, str]] = []
+    halt = session.robot.halt
+
+    def recording() -> None:
+        seen.append((session._cancel.is_set(), session._cancel_reason))
+        halt()
+
+    session.robot.halt = recording  # type: ignore[method-assign]
+    try:
+        actor = Actor("console", session.lease.acquire("test", "console"))
+        session._start(actor, "motion", lambda: session._cancel.wait(5.0), motion=True)
+        end = time.monotonic() + 5.0
+        while not seen and time.monotonic() < end:
+            time.sleep(0.05)
+        assert seen == [(True, SILENT_REASON)]
     finally:
         session.close()

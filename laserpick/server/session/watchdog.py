@@ -89,14 +89,19 @@ class Watchdog(SessionCore):
 
     def _halt_motion(self, reason: str) -> None:
         """Halt arm and base (the controller has, or does now), end the job with `reason`,
-        and keep the controller refusing motion until the job has wound down."""
+        and keep the controller refusing motion until the job has wound down. The reason is
+        set before the halt, so that the job, which sees its motion halted at once, reads it;
+        the lock, which a command may hold, is taken only after the halt. A job started since
+        clears the cancel (`_start`)."""
+        busy = self.busy
+        if busy:
+            self._cancel_reason = reason
+            self._cancel.set()
         self.robot.deadman(time.monotonic())
         self.robot.halt()
         self._tripped = True
         with self._lock:
-            if self.busy:
-                self._cancel_reason = reason
-                self._cancel.set()
+            if busy:
                 self._motion_token = None
             self._drive_until = 0.0
             self.message = f"{reason.split(',')[0]}: motion halted."
