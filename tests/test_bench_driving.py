@@ -23,7 +23,7 @@ from laserpick.bench.route_planning import (
     turn_poses,
 )
 from laserpick.description import dims
-from laserpick.pipeline.first_plan import UNSEEN_WAYS
+from laserpick.pipeline.parking_advice import UNSEEN_WAYS
 from laserpick.robot.sim.scenes import load_scene
 from laserpick.transforms import invert, planar_pose
 

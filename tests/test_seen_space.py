@@ -17,10 +17,10 @@ from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.collision import UNSTOW_BOX, CollisionChecker
-from laserpick.pipeline.first_plan import UNSEEN_WAYS, park_aside_sentence, plan_first
+from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches, joint_path
-from laserpick.pipeline.parking_advice import ASIDE_STEP
+from laserpick.pipeline.parking_advice import ASIDE_STEP, UNSEEN_WAYS, park_aside_sentence
 from laserpick.pipeline.plan import plan_pick, transit_path
 from laserpick.pipeline.selection import group
 from laserpick.robot.sim.robot import SimRobot

@@ -20,10 +20,11 @@ from laserpick.behaviours.messages import NO_BASKET_HOLD
 from laserpick.behaviours.outcome import Outcome
 from laserpick.behaviours.withdraw import Withdrawing
 from laserpick.description.kinematics import tcp_pose
-from laserpick.pipeline.first_plan import park_aside_sentence, plan_first
+from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
+from laserpick.pipeline.parking_advice import park_aside_sentence
 from laserpick.pipeline.plan import PickPlan
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.types import Failure, Grasp

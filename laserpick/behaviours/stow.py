@@ -9,9 +9,9 @@ from laserpick.behaviours.outcome import Outcome
 from laserpick.description import dims
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.first_plan import at_pose, at_rest
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
+from laserpick.pipeline.rest_poses import at_pose, at_rest
 
 __all__ = ["Stowing"]
 

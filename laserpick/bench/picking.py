@@ -26,7 +26,7 @@ from laserpick.behaviours import warm_drop_postures
 from laserpick.bench.attempts import Attempt, motion_timings, stage_timings
 from laserpick.bench.referee import Referee, View
 from laserpick.pipeline.balance import hold_lever
-from laserpick.pipeline.first_plan import at_rest
+from laserpick.pipeline.rest_poses import at_rest
 from laserpick.robot.sim.robot import SimRobot
 from laserpick.robot.sim.scenes import Scene
 from laserpick.server.session import (

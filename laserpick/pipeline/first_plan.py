@@ -20,30 +20,15 @@ from laserpick.description.dims import (
 )
 from laserpick.pipeline.grasp_choice import GraspSet
 from laserpick.pipeline.joint_search import Searches
-from laserpick.pipeline.parking_advice import park_aside_advice
+from laserpick.pipeline.parking_advice import unseen_ways_failure
 from laserpick.pipeline.pick_prep import PickPrep, prepare_pick
 from laserpick.pipeline.plan import NO_WAY, PickPlan, transit_path, transit_to_any, way_to
+from laserpick.pipeline.rest_poses import at_pose
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
 
-__all__ = [
-    "QUICK_SAMPLES",
-    "READY_TOLERANCE",
-    "SEARCHING_LONGER",
-    "UNSEEN_WAYS",
-    "at_pose",
-    "at_rest",
-    "park_aside_sentence",
-    "plan_first",
-]
+__all__ = ["QUICK_SAMPLES", "SEARCHING_LONGER", "plan_first"]
 
-READY_TOLERANCE = 0.05  #: rad: the arm counts as at the ready (or stowed) pose within this
-#: Said after a pick's planning failure when some way to its grasps passed only through space
-#: no camera saw: the arm keeps to seen space, so the user knows why it did not go.
-UNSEEN_WAYS = (
-    "; the only ways found pass where the cameras could not see, and the arm keeps to where"
-    " they saw"
-)
 #: Said while a pick plans, when the short searches found no way: the full ones take seconds
 #: (a juice bottle on the 108 cm table: 11-45 s in six of sixteen fresh `pick-place`
 #: kitchens, beside another bench, where the user saw nothing new since "Picking.").
@@ -54,17 +39,6 @@ SEARCHING_LONGER = "No way to the grasps was found at once; searching longer, fo
 #: found, before the fourth grasp's way was found at once. The short searches may miss as
 #: often as the full ones may fail (`rrt_max_failed`).
 QUICK_SAMPLES = 300
-
-
-def at_pose(q: np.ndarray | None, pose: np.ndarray) -> bool:
-    """Whether joint angles q (6,) (rad) are at `pose` (6,), within READY_TOLERANCE."""
-    return q is not None and bool(np.max(np.abs(q - pose)) < READY_TOLERANCE)
-
-
-def at_rest(q: np.ndarray | None) -> bool:
-    """Whether joint angles q (6,) (rad) are at a pose the arm rests in between tasks: stowed
-    (`UR5_HOME_Q`) or standing by between picks (`UR5_STANDBY_Q`)."""
-    return at_pose(q, UR5_HOME_Q) or at_pose(q, UR5_STANDBY_Q)
 
 
 def plan_first(
@@ -141,27 +115,8 @@ def plan_first(
     if searches.stopped:
         return plan, None, first.tried
     if isinstance(plan, Failure) and not last.refused and searches.unseen_only(s):
-        plan = _unseen_ways_failure(plan, found.middle)
+        plan = unseen_ways_failure(plan, found.middle)
     return plan, None, first.tried
-
-
-def _unseen_ways_failure(failure: Failure, middle: np.ndarray) -> Failure:
-    """`failure` (no way found) said again with why (`UNSEEN_WAYS`), carrying how far to
-    park to a side for the object, whose middle is at `middle` (m, `base`), to stand nearer
-    the middle of the cameras' view (`park_aside_advice`, `Failure.park_left`; the pick says
-    it with `park_aside_sentence`)."""
-    msg = f"{failure.message.rstrip('.')}{UNSEEN_WAYS}"
-    return Failure("ik_plan", msg, park_left=park_aside_advice(middle))
-
-
-def park_aside_sentence(left: float) -> str:
-    """What the robot asks where it would have the scooter park `left` m to its left
-    (negative: right): a sentence to follow the failure's."""
-    side = "left" if left > 0 else "right"
-    return (
-        f" Park about {round(abs(left) * 100)} cm farther to your {side} and mark it again:"
-        " there it stands nearer the middle of the cameras' view."
-    )
 
 
 def _place(grasps: Sequence[Grasp], grasp: Grasp) -> int:

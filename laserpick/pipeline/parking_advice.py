@@ -28,17 +28,27 @@ import numpy as np
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.reach import reachable
 from laserpick.settings import MotionSettings
-from laserpick.types import Grasp
+from laserpick.types import Failure, Grasp
 
 __all__ = [
     "ADVICE_GRASPS",
     "ASIDE_STEP",
     "BACK_UP_STEPS",
     "IN_VIEW_Y",
+    "UNSEEN_WAYS",
     "back_up_advice",
     "backed_up_grasps",
     "park_aside_advice",
+    "park_aside_sentence",
+    "unseen_ways_failure",
 ]
+
+#: Said after a pick's planning failure when some way to its grasps passed only through space
+#: no camera saw: the arm keeps to seen space, so the user knows why it did not go.
+UNSEEN_WAYS = (
+    "; the only ways found pass where the cameras could not see, and the arm keeps to where"
+    " they saw"
+)
 
 #: How far back (m) the robot considers asking the user to park, nearest first: a person
 #: backs a scooter up by a hand's breadth or two, not across the room. The least that serves
@@ -107,3 +117,22 @@ def park_aside_advice(middle: np.ndarray) -> float | None:
     if not np.isfinite(off) or abs(off) < ASIDE_STEP / 2:
         return None
     return math.copysign(ASIDE_STEP, off)
+
+
+def unseen_ways_failure(failure: Failure, middle: np.ndarray) -> Failure:
+    """`failure` (no way found) said again with why (`UNSEEN_WAYS`), carrying how far to
+    park to a side for the object, whose middle is at `middle` (m, `base`), to stand nearer
+    the middle of the cameras' view (`park_aside_advice`, `Failure.park_left`; the pick says
+    it with `park_aside_sentence`)."""
+    msg = f"{failure.message.rstrip('.')}{UNSEEN_WAYS}"
+    return Failure("ik_plan", msg, park_left=park_aside_advice(middle))
+
+
+def park_aside_sentence(left: float) -> str:
+    """What the robot asks where it would have the scooter park `left` m to its left
+    (negative: right): a sentence to follow the failure's."""
+    side = "left" if left > 0 else "right"
+    return (
+        f" Park about {round(abs(left) * 100)} cm farther to your {side} and mark it again:"
+        " there it stands nearer the middle of the cameras' view."
+    )

@@ -13,8 +13,8 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 
 from laserpick.pipeline.collision import CollisionChecker
-from laserpick.pipeline.first_plan import at_rest
 from laserpick.pipeline.recall import Recalled
+from laserpick.pipeline.rest_poses import at_rest
 from laserpick.robot.interface import Robot
 from laserpick.server.session.captures import Capture, CaptureReads
 

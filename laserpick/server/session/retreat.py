@@ -13,8 +13,8 @@ from dataclasses import replace
 from laserpick.behaviours import Outcome, wait_for_gripper
 from laserpick.description.kinematics import tcp_pose
 from laserpick.pipeline.collision import CollisionChecker, not_carried, self_filter
-from laserpick.pipeline.first_plan import at_rest
 from laserpick.pipeline.recall import moved, moved_points
+from laserpick.pipeline.rest_poses import at_rest
 from laserpick.pipeline.surface import still_standing
 from laserpick.robot.interface import DEADMAN_STOP
 from laserpick.server.session.captures import Capture
