@@ -15,6 +15,7 @@ from laserpick.pipeline import plan as plan_module
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.grasp_choice import GraspSet
+from laserpick.pipeline.plan_record import RECORD_PICKS_ENV, load_pick
 from laserpick.pipeline.reach import pregrasp_pose
 from laserpick.pipeline.selection import group
 from laserpick.settings import get_settings
@@ -278,3 +279,23 @@ def test_a_cancel_while_planning_makes_no_further_search(monkeypatch) -> None:
     searched.clear()
     plan_first(found, dims.UR5_READY_Q, np.random.default_rng(0))
     assert searched.count(get_settings().motion.rrt_max_samples) >= 2
+
+
+def test_a_recorded_pick_is_planned_again_alike(monkeypatch, tmp_path) -> None:
+    """With LASERPICK_RECORD_PICKS set, `plan_first` writes what it was given; loaded
+    (`load_pick`), the same pick plans to the same grasp and the same transit, and its
+    generator draws as the pick's did, from before its first draw."""
+    monkeypatch.setenv(RECORD_PICKS_ENV, str(tmp_path))
+    found = _grasps_pick((1.5, -0.25, 0.50), (1.6, -0.2, 0.55))
+    refused = found.ordered()[0]
+    admit = lambda g: Failure("ik_plan", "not this one") if g is refused else None  # noqa: E731
+    rng = np.random.default_rng(7)
+    draw = np.random.default_rng(7).integers(2**32)
+    plan, grasp, place = plan_first(found, dims.UR5_STANDBY_Q, rng, admit=admit)
+    assert not isinstance(plan, Failure) and place == 2 and grasp is found.ordered()[1]
+    (path,) = tmp_path.glob("*.pkl")
+    pick = load_pick(path)
+    assert pick["rng"].integers(2**32) == draw
+    again, _, place_again = plan_first(**load_pick(path))
+    assert not isinstance(again, Failure) and place_again == place
+    assert np.array_equal(again.transit.q, plan.transit.q)

@@ -23,6 +23,7 @@ from laserpick.pipeline.joint_search import Searches
 from laserpick.pipeline.parking_advice import unseen_ways_failure
 from laserpick.pipeline.pick_prep import PickPrep, prepare_pick
 from laserpick.pipeline.plan import NO_WAY, PickPlan, transit_path, transit_to_any, way_to
+from laserpick.pipeline.plan_record import record_pick
 from laserpick.pipeline.rest_poses import at_pose
 from laserpick.settings import MotionSettings, get_settings
 from laserpick.types import Failure, Grasp
@@ -88,6 +89,7 @@ def plan_first(
     """
     s = settings or get_settings().motion
     grasps = list(found.ordered() if order is None else order)
+    record_pick(found, q_now, rng, grasps, s, admit)
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     pick = _Pick(found, q_now, rng, admit)
     searches = Searches(s.rrt_max_failed, stop=stop)

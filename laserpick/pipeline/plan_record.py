@@ -3,22 +3,34 @@ search `joint_search.joint_path` starts (the straight move was blocked, both end
 to DIR as one .npz: the start and goal (rad), the collision checker's inputs (its cloud in
 `base`, m; margin and floor clearance, m; the depth frames and the arm's own space of its
 seen-space test) and the check's options. `bench/planners.py` replays them with each search.
+
+With LASERPICK_RECORD_PICKS=DIR set, every pick's planning (`first_plan.plan_first`) is
+written to DIR as one pickle of what it was given: the grasps and their clouds, where the
+arm stood, the state of its generator, the order and settings, and what `admit` said of
+each grasp. `bench/pick_planning.py` plans them again: the planning stage's time on a
+machine of one's choosing, and the same picks planned by two versions of the code. A
+pickle holds the classes by name: it is read by code whose grasp and cloud types match.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import pickle
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.collision.seen_space import OwnSpace
-from laserpick.types import DepthFrame
+from laserpick.settings import MotionSettings
+from laserpick.types import DepthFrame, Failure, Grasp
 
 #: The environment variable naming the folder problems are written to; unset: none are.
 RECORD_ENV = "LASERPICK_RECORD_PLANS"
+#: The environment variable naming the folder picks' planning is written to; unset: none is.
+RECORD_PICKS_ENV = "LASERPICK_RECORD_PICKS"
 #: The checker options a problem keeps (`CollisionChecker.clearance_ok`'s keywords).
 OPTIONS = ("hand", "seen", "payload", "margin")
 
@@ -84,3 +96,56 @@ def load_search(path: str | Path) -> tuple[np.ndarray, np.ndarray, CollisionChec
             value = data[f"opt_{name}"]
             kw[name] = value.item() if value.ndim == 0 else value
     return data["q_start"], data["q_goal"], checker, kw
+
+
+def record_pick(
+    found: object,
+    q_now: np.ndarray,
+    rng: np.random.Generator,
+    order: Sequence[Grasp],
+    settings: MotionSettings,
+    admit: Callable[[Grasp], Failure | None] | None,
+) -> Path | None:
+    """Write what `plan_first` was given (`found`, a `GraspSet`; q_now (6,) rad; the state
+    of `rng` before it draws; `order`; `settings`, its `MotionSettings`; and `admit`'s
+    verdict on each grasp of `order`) to $LASERPICK_RECORD_PICKS, named by a hash of it.
+    Returns the file, or None when recording is off."""
+    folder = os.environ.get(RECORD_PICKS_ENV)
+    if not folder:
+        return None
+    refusals = None if admit is None else [admit(g) for g in order]
+    pick = {
+        "found": found,
+        "q_now": np.asarray(q_now, float),
+        "rng_state": rng.bit_generator.state,
+        "order": list(order),
+        "settings": settings,
+        "refusals": refusals,
+    }
+    blob = pickle.dumps(pick, protocol=pickle.HIGHEST_PROTOCOL)
+    path = Path(folder) / f"{hashlib.sha1(blob).hexdigest()[:16]}.pkl"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(blob)
+    return path
+
+
+def load_pick(path: str | Path) -> dict:
+    """A pick `record_pick` wrote, as `plan_first`'s arguments: found, q_now, rng (a new
+    generator in the recorded state), order, settings and admit (None, or the recorded
+    verdicts by grasp)."""
+    pick = pickle.loads(Path(path).read_bytes())
+    rng = np.random.default_rng()
+    rng.bit_generator.state = pick["rng_state"]
+    order, refusals, admit = pick["order"], pick["refusals"], None
+    if refusals is not None:
+        verdicts = {id(g): r for g, r in zip(order, refusals, strict=True)}
+        admit = lambda g: verdicts[id(g)]  # noqa: E731
+    return {
+        "found": pick["found"],
+        "q_now": pick["q_now"],
+        "rng": rng,
+        "order": order,
+        # Settings added since the recording take their defaults.
+        "settings": MotionSettings.model_validate(dict(vars(pick["settings"]))),
+        "admit": admit,
+    }
