@@ -253,36 +253,6 @@ def test_a_search_toward_several_goals_ends_at_one_it_reaches():
     assert np.array_equal(path, np.stack([q0, beside]))
 
 
-def test_ompls_search_toward_several_goals_grows_from_them_all_at_once(monkeypatch):
-    """Of two goals, the first walled in, OMPL's search ends at the other having asked fewer
-    configurations of the check than a search toward the walled-in goal alone spends before
-    it gives up: the walled-in goal does not take its whole budget first."""
-    walled = ik_tcp(top_grasp(1.6, -0.5, 0.65), dims.UR5_READY_Q)[0]
-    start = walled + np.array([1.2, 0, 0, 0, 0, 0])
-    other = start + np.array([0, 0, 0, 0, 0.6, 0.8])
-    checker = CollisionChecker(_mould(walled, start), voxel=0.0)
-    asked = [0]
-    check = checker.clearance_ok
-
-    def counting(Q, **kw):
-        asked[0] += len(np.atleast_2d(Q))
-        return check(Q, **kw)
-
-    monkeypatch.setattr(checker, "clearance_ok", counting)
-    s = get_settings().motion.model_copy(update={"planner": "ompl", "rrt_max_samples": 300})
-    assert joint_path(start, walled, checker, np.random.default_rng(0), s) is None
-    alone, asked[0] = asked[0], 0
-    goals = np.stack([walled, other])
-    for seed in range(3):  # the search itself: the straight move to `other` is clear
-        path = joint_search._search(
-            start, goals, checker, np.random.default_rng(seed), s, "ompl", {}
-        )
-        assert path is not None and np.array_equal(path[0], start)
-        assert np.array_equal(path[-1], other)
-        assert all(checker.segment_ok(a, b) for a, b in itertools.pairwise(path))
-    assert asked[0] / 3 < alone / 2, (asked[0] / 3, alone)
-
-
 def test_a_search_grown_in_parts_draws_and_finds_as_one_grown_at_once():
     q0, q1, checker = _wall_between()
     whole = rrt.rrt_connect(q0, q1, checker, np.random.default_rng(3), max_samples=2000)

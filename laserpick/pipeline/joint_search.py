@@ -98,10 +98,11 @@ def _search(
     kw: dict,
 ) -> np.ndarray | None:
     """A clear, shortened joint path from q_start to one of `goals` (k, 6) rad, best first,
-    by `planner`; None where the search found none. Both grow the goal side from every goal
-    at once (OMPL's posed the other way round, `ompl_connect`): searched one after another,
-    goals in a pocket spent the whole search each (a cereal box's drops deep in the basket,
-    20 s a goal)."""
+    by `planner`; None where the search found none. Ours grows the goal side from every goal
+    at once: searched one after another, goals in a pocket spent the whole search each (a
+    cereal box's drops deep in the basket, 20 s a goal). OMPL's RRT-Connect adds a further goal to
+    its goal tree only as that tree grows, so a goal in a pocket keeps it from the others:
+    it searches them one after another."""
     for goal in goals:
         record_search(q_start, goal, checker, kw)
     if planner == "ours":
@@ -110,7 +111,11 @@ def _search(
         )
         return None if path is None else shortcut(path, checker, rng, **kw)
     budget = {"max_samples": s.rrt_max_samples, "time_budget": s.search_time}
-    return ompl_connect(q_start, goals, checker, rng, **budget, **kw)
+    for goal in goals:
+        path = ompl_connect(q_start, goal, checker, rng, **budget, **kw)
+        if path is not None:
+            return path
+    return None
 
 
 def joint_path_via(

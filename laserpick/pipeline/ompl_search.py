@@ -4,11 +4,6 @@ The collision check stays ours: each state and each straight edge is asked of a
 `CollisionChecker` (its spheres against the cloud), an edge at the resolution of
 `CollisionChecker.segment_ok`, and the path OMPL returns is checked again edge by edge.
 
-Toward several goals, the search is posed the other way round: OMPL's RRT-Connect roots
-every start state in its start tree at once but adds a further goal to its goal tree only
-as that tree grows, so a goal in a pocket kept it from the others. Posed from the goals to
-the start, it grows from all of them at once, and the path found is turned round.
-
 Deterministic: OMPL's random generators are seeded from the caller's generator before each
 search, and the search stops after a number of samples (a wall-clock budget only caps it
 for a machine far slower than the bench's). Frames: joint angles in rad.
@@ -111,28 +106,10 @@ def _simplify(si, path) -> None:
     simplifier.reduceVertices(path)
 
 
-def _waypoints(path, q_start: np.ndarray, goals: np.ndarray, reverse: bool) -> np.ndarray:
-    """The path's states (K, 6) rad from q_start to the goal of `goals` (k, 6) it reached,
-    turned round where the search was posed from the goals; its ends exactly as given."""
+def _waypoints(path, q_start: np.ndarray, q_goal: np.ndarray) -> np.ndarray:
     out = np.array([_as_q(path.getState(i)) for i in range(path.getStateCount())])
-    if reverse:
-        out = out[::-1]
-    reached = np.linalg.norm(goals - out[-1], axis=1).argmin()
-    out[0], out[-1] = q_start, goals[reached]
+    out[0], out[-1] = q_start, q_goal
     return out
-
-
-def _problem(si, space, q_start: np.ndarray, goals: np.ndarray) -> tuple[object, bool]:
-    """OMPL's problem from q_start to one of `goals` (k, 6); with several goals, posed from
-    them to q_start (module docstring). Returns it and whether it was turned round."""
-    problem = ob.ProblemDefinition(si)
-    if len(goals) == 1:
-        problem.setStartAndGoalStates(_state(space, q_start), _state(space, goals[0]))
-        return problem, False
-    for goal in goals:
-        problem.addStartState(_state(space, goal))
-    problem.setGoalState(_state(space, q_start))
-    return problem, True
 
 
 def ompl_connect(
@@ -146,19 +123,18 @@ def ompl_connect(
     search_range: float = OMPL_RANGE,
     **kw,
 ) -> np.ndarray | None:
-    """A clear, shortened joint path (K, 6) rad from q_start to q_goal (6,), or to whichever
-    of goals q_goal (k, 6) it reaches, or None when RRT-Connect found none within
-    `max_samples` samples (or `time_budget` s of wall-clock time).
+    """A clear, shortened joint path (K, 6) rad from q_start to q_goal, or None when RRT-Connect
+    found none within `max_samples` samples (or `time_budget` s of wall-clock time).
 
     rng: draws the search's seed (one draw); kw: `CollisionChecker.clearance_ok`'s options
     (hand, seen, payload), for states and edges alike. Both ends must be clear (the caller
     checks): OMPL reports an invalid start or goal as no path.
     """
     _reseed(int(rng.integers(1, _SEED_BOUND)))
-    q_start, goals = np.asarray(q_start, float), np.atleast_2d(np.asarray(q_goal, float))
-    lo, hi = search_bounds(q_start, goals)
+    lo, hi = search_bounds(np.asarray(q_start, float), np.asarray(q_goal, float))
     space, si, validator = _space(lo, hi, checker, kw)
-    problem, reverse = _problem(si, space, q_start, goals)
+    problem = ob.ProblemDefinition(si)
+    problem.setStartAndGoalStates(_state(space, q_start), _state(space, q_goal))
     planner = og.RRTConnect(si)
     planner.setRange(search_range)
     planner.setProblemDefinition(problem)
@@ -179,7 +155,7 @@ def ompl_connect(
     # saw only at the edge's own steps: checked at its own, it may touch. The path as found
     # was checked edge by edge as it stands.
     for candidate in (path, found):
-        out = _waypoints(candidate, q_start, goals, reverse)
+        out = _waypoints(candidate, q_start, q_goal)
         if all(validator.ok(a, b) for a, b in itertools.pairwise(out)):
             return out
     return None
