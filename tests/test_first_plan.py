@@ -299,3 +299,41 @@ def test_a_recorded_pick_is_planned_again_alike(monkeypatch, tmp_path) -> None:
     again, _, place_again = plan_first(**load_pick(path))
     assert not isinstance(again, Failure) and place_again == place
     assert np.array_equal(again.transit.q, plan.transit.q)
+
+
+class _NoStraightMove:
+    """A world where every configuration is clear and no straight move is."""
+
+    frames = ()
+
+    def segment_ok(self, *args, **kw) -> bool:
+        return False
+
+    def clearance_ok(self, Q, **kw) -> np.ndarray:
+        return np.ones(len(np.atleast_2d(Q)), bool)
+
+
+@pytest.mark.parametrize("each_goal", [False, True])
+def test_a_full_search_toward_several_grasps_counts_each_goal_it_found_no_way_to(
+    monkeypatch, each_goal
+) -> None:
+    """OMPL searches several goals one after another, each with the whole budget: with
+    `each_goal` (a pick's full searches) each goal it found no way to counts as a failed
+    search, and the search stops once the pick's budget is spent; without (the short
+    searches), the leg counts once, every goal searched."""
+    searched: list[float] = []
+
+    def no_way(q_start, goal, *args, **kw):
+        searched.append(float(goal[0]))
+        return None
+
+    monkeypatch.setattr(joint_search, "ompl_connect", no_way)
+    s = get_settings().motion.model_copy(update={"pick_planner": "ompl"})
+    searches = joint_search.Searches(max_failed=3, each_goal=each_goal)
+    goals = np.array([np.full(6, 0.1 * k) for k in range(1, 6)])
+    rng = np.random.default_rng(0)
+    assert searches.path(np.zeros(6), goals, _NoStraightMove(), rng, s, seen=False) is None
+    if each_goal:
+        assert searched == pytest.approx([0.1, 0.2, 0.3]) and searches.spent
+    else:
+        assert len(searched) == 5 and searches.failed == 1 and not searches.spent

@@ -92,7 +92,7 @@ def plan_first(
     record_pick(found, q_now, rng, grasps, s, admit)
     via = () if at_pose(q_now, UR5_READY_Q) else (UR5_READY_Q, UR5_HIGH_READY_Q)
     pick = _Pick(found, q_now, rng, admit)
-    searches = Searches(s.rrt_max_failed, stop=stop)
+    searches = Searches(s.rrt_max_failed, stop=stop, each_goal=True)
     if s.rrt_max_samples > QUICK_SAMPLES:
         quick = Searches(s.rrt_max_failed, stop=stop)
         short = s.model_copy(update={"rrt_max_samples": QUICK_SAMPLES})

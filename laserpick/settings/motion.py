@@ -164,7 +164,8 @@ class MotionSettings(BaseModel):
         6,
         ge=1,
         description="Failed joint-space searches in one pick before no more grasps are tried:"
-        " each takes seconds, and a user should not wait minutes for a 'no'. Ours.",
+        " each takes seconds, and a user should not wait minutes for a 'no'; a full OMPL"
+        " search toward several grasps counts one for each it found no way to. Ours.",
     )
     place_below: float = Field(
         0.02,
