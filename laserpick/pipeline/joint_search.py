@@ -204,8 +204,8 @@ class Searches:
                 a, b, known, rng, s, planner=s.pick_planner, give_up=give_up, hand=True, seen=seen
             )
             self.legs[key] = leg
-            if leg is None:
-                self.failed += self.failed == before  # once, where not counted goal by goal
+            if leg is None and self.failed == before:  # once, where not counted goal by goal
+                self.failed += 1
             # Keyed as `legs`: searched again after `forget_failed`, still one leg.
             if leg is None and seen and checker.frames:
                 self.blocked.setdefault(key, (a, b, checker))
