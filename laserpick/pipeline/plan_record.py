@@ -10,6 +10,7 @@ arm stood, the state of its generator, the order and settings, and what `admit` 
 each grasp. `bench/pick_planning.py` plans them again: the planning stage's time on a
 machine of one's choosing, and the same picks planned by two versions of the code. A
 pickle holds the classes by name: it is read by code whose grasp and cloud types match.
+Loading a pickle runs what it names: load only recordings you made.
 """
 
 from __future__ import annotations
