@@ -20,6 +20,7 @@ import os
 import pickle
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +28,9 @@ from laserpick.pipeline.collision import CollisionChecker
 from laserpick.pipeline.collision.seen_space import OwnSpace
 from laserpick.settings import MotionSettings
 from laserpick.types import DepthFrame, Failure, Grasp
+
+if TYPE_CHECKING:  # grasp_choice is above the searches that record problems here
+    from laserpick.pipeline.grasp_choice import GraspSet
 
 #: The environment variable naming the folder problems are written to; unset: none are.
 RECORD_ENV = "LASERPICK_RECORD_PLANS"
@@ -100,15 +104,15 @@ def load_search(path: str | Path) -> tuple[np.ndarray, np.ndarray, CollisionChec
 
 
 def record_pick(
-    found: object,
+    found: GraspSet,
     q_now: np.ndarray,
     rng: np.random.Generator,
     order: Sequence[Grasp],
     settings: MotionSettings,
     admit: Callable[[Grasp], Failure | None] | None,
 ) -> Path | None:
-    """Write what `plan_first` was given (`found`, a `GraspSet`; q_now (6,) rad; the state
-    of `rng` before it draws; `order`; `settings`, its `MotionSettings`; and `admit`'s
+    """Write what `plan_first` was given (`found`; q_now (6,) rad; the state of `rng`
+    before it draws; `order`; `settings`, its `MotionSettings`; and `admit`'s
     verdict on each grasp of `order`) to $LASERPICK_RECORD_PICKS, named by a hash of it.
     Returns the file, or None when recording is off."""
     folder = os.environ.get(RECORD_PICKS_ENV)
@@ -137,10 +141,7 @@ def load_pick(path: str | Path) -> dict:
     pick = pickle.loads(Path(path).read_bytes())
     rng = np.random.default_rng()
     rng.bit_generator.state = pick["rng_state"]
-    order, refusals, admit = pick["order"], pick["refusals"], None
-    if refusals is not None:
-        verdicts = {id(g): r for g, r in zip(order, refusals, strict=True)}
-        admit = lambda g: verdicts[id(g)]  # noqa: E731
+    order, refusals = pick["order"], pick["refusals"]
     return {
         "found": pick["found"],
         "q_now": pick["q_now"],
@@ -148,5 +149,13 @@ def load_pick(path: str | Path) -> dict:
         "order": order,
         # Settings added since the recording take their defaults.
         "settings": MotionSettings.model_validate(dict(vars(pick["settings"]))),
-        "admit": admit,
+        "admit": None if refusals is None else _recorded_admit(order, refusals),
     }
+
+
+def _recorded_admit(
+    order: Sequence[Grasp], refusals: Sequence[Failure | None]
+) -> Callable[[Grasp], Failure | None]:
+    """`admit` as recorded: the verdict on each grasp of `order`, by the grasp itself."""
+    verdicts = {id(g): r for g, r in zip(order, refusals, strict=True)}
+    return lambda grasp: verdicts[id(grasp)]
