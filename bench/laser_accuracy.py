@@ -14,7 +14,7 @@ import argparse
 import numpy as np
 
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.laser_spots import detect_mark
+from laserpick.pipeline.laser_mark import detect_mark
 from laserpick.robot.sim.truth import capture
 from laserpick.types import Failure
 

@@ -1,4 +1,5 @@
-"""Laser mark detection (pipeline/laser_spots.py) against the simulator's true beam hits."""
+"""Laser mark detection (pipeline/laser_spots.py, laser_mark.py) against the simulator's true
+beam hits."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ import numpy as np
 import pytest
 
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.laser_spots import detect_mark, direct_mark, find_spots, pair_spots
+from laserpick.pipeline.laser_mark import detect_mark, direct_mark
+from laserpick.pipeline.laser_spots import find_spots, pair_spots
 from laserpick.robot.sim.truth import capture
 from laserpick.settings import get_settings
 from laserpick.types import Failure, LaserMark

@@ -17,7 +17,7 @@ from laserpick.pipeline.first_plan import plan_first
 from laserpick.pipeline.gpd import detect_grasps
 from laserpick.pipeline.grasp_choice import GraspSet, find_grasps
 from laserpick.pipeline.joint_search import joint_path
-from laserpick.pipeline.laser_spots import detect_mark
+from laserpick.pipeline.laser_mark import detect_mark
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import motion_limits, timed
 from laserpick.pipeline.perceive import Perception, perceive

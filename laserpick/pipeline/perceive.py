@@ -14,7 +14,7 @@ from typing import Literal, TypeVar
 import numpy as np
 
 from laserpick.pipeline.cloud import fuse
-from laserpick.pipeline.laser_spots import detect_mark, direct_mark
+from laserpick.pipeline.laser_mark import detect_mark, direct_mark
 from laserpick.pipeline.segment import segment_target
 from laserpick.settings import PerceptionSettings, get_settings
 from laserpick.types import DepthFrame, Failure, FusedCloud, LaserMark, Segmentation

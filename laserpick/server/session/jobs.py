@@ -15,7 +15,7 @@ from laserpick.behaviours import CARRY_PLANNING, TUCKING_FIRST, Outcome
 from laserpick.description import dims
 from laserpick.pipeline.cloud import fuse
 from laserpick.pipeline.grasp_choice import find_grasps
-from laserpick.pipeline.laser_spots import detect_mark
+from laserpick.pipeline.laser_mark import detect_mark
 from laserpick.pipeline.perceive import perceive
 from laserpick.pipeline.projector import highlight_disc, highlight_points
 from laserpick.pipeline.selection import GraspCursor
