@@ -299,6 +299,10 @@ def test_a_recorded_pick_is_planned_again_alike(monkeypatch, tmp_path) -> None:
     again, _, place_again = plan_first(**load_pick(path))
     assert not isinstance(again, Failure) and place_again == place
     assert np.array_equal(again.transit.q, plan.transit.q)
+    # The replay, recording too, wrote the same pick again, named second in the run's order.
+    first, second = sorted(tmp_path.glob("*.pkl"))
+    assert first == path and first.name.startswith("0000-") and second.name.startswith("0001-")
+    assert np.array_equal(load_pick(second)["q_now"], pick["q_now"])
 
 
 class _NoStraightMove:

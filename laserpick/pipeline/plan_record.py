@@ -113,8 +113,9 @@ def record_pick(
 ) -> Path | None:
     """Write what `plan_first` was given (`found`; q_now (6,) rad; the state of `rng`
     before it draws; `order`; `settings`, its `MotionSettings`; and `admit`'s
-    verdict on each grasp of `order`) to $LASERPICK_RECORD_PICKS, named by a hash of it.
-    Returns the file, or None when recording is off."""
+    verdict on each grasp of `order`) to $LASERPICK_RECORD_PICKS, named by its place among
+    the picks recorded there and a hash of it (`0007-3fa2….pkl`), so the names sort in the
+    order a run planned them. Returns the file, or None when recording is off."""
     folder = os.environ.get(RECORD_PICKS_ENV)
     if not folder:
         return None
@@ -128,8 +129,10 @@ def record_pick(
         "refusals": refusals,
     }
     blob = pickle.dumps(pick, protocol=pickle.HIGHEST_PROTOCOL)
-    path = Path(folder) / f"{hashlib.sha1(blob).hexdigest()[:16]}.pkl"
-    path.parent.mkdir(parents=True, exist_ok=True)
+    folder_path = Path(folder)
+    folder_path.mkdir(parents=True, exist_ok=True)
+    place = sum(1 for _ in folder_path.glob("*.pkl"))
+    path = folder_path / f"{place:04d}-{hashlib.sha1(blob).hexdigest()[:16]}.pkl"
     path.write_bytes(blob)
     return path
 
