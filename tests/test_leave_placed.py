@@ -9,6 +9,7 @@ from arm_setups import (
     BEHAVIOUR,
     DATA,
     RAIL_TOP,
+    SETTINGS,
     TABLE_TOP,
     hand_at,
     isolation_robot,
@@ -22,7 +23,8 @@ from laserpick.behaviours import Behaviours
 from laserpick.bench.referee import Referee
 from laserpick.description import dims
 from laserpick.description.kinematics import ik_tcp, tcp_pose
-from laserpick.pipeline.collision import CollisionChecker
+from laserpick.description.shapes import body_frames
+from laserpick.pipeline.collision import SPHERES, CollisionChecker, sphere_centres
 from laserpick.pipeline.lines import cartesian_line
 from laserpick.pipeline.motion_limits import timed
 from laserpick.transforms import rotx
@@ -243,6 +245,36 @@ def test_pads_that_still_press_what_the_hand_let_go_of_are_freed_before_it_rises
         assert moves[0] == "freeing the fingers" and "easing the pads off" in moves
         robot.sleep(BEHAVIOUR.leave_settle)
         assert robot.gripper_state().force <= BEHAVIOUR.pads_clear
+
+
+def test_the_pads_are_freed_only_as_far_as_the_arm_keeps_its_clearance():
+    """Lowered and eased sideways, the open hand takes the arm with it: over the basket a
+    1 cm easing brought the arm within the margin of a sensor post, from where no way to
+    stand by, to ready or to stow could start. Here something stands just outside the
+    margin on either side of the wrist, along the closing axis the pads ease along: they
+    are eased only as far as that margin, and the arm keeps its clearance."""
+    with scene_robot(str(DATA / "rail.yaml")) as robot:
+        b = Behaviours(robot)
+        hand_at(b, top_down(1.60, -0.30, RAIL_TOP + 0.10))
+        _press_a_pad_on_the_rail(b)
+        q = robot.joint_state().q
+        closing = tcp_pose(q)[:3, 1]
+        arm = ~SPHERES.hand
+        centres = sphere_centres(body_frames(q))[0][arm]
+        reach = SPHERES.radius[arm] + SETTINGS.motion.clearance
+        wrist = int(np.argmax(centres @ -tcp_pose(q)[:3, 2]))  # the arm's lowest sphere
+        sides = []
+        for way in (1.0, -1.0):  # out along the closing axis to 2 mm past every margin
+            t = np.arange(0.0, 0.3, 0.001)
+            at = centres[wrist] + np.outer(t, way * closing)
+            gap = np.linalg.norm(at[:, None] - centres[None], axis=2) - reach
+            sides.append(at[np.argmax((gap > 0).all(axis=1))] + 0.002 * way * closing)
+        beside = CollisionChecker(np.array(sides), margin=SETTINGS.motion.clearance)
+        assert beside.clearance_ok(q, hand=False)[0], "the arm starts clear"
+        moves = recorded_moves(b)
+        assert b.free_the_pads(beside) is True
+        assert "easing the pads off" in moves, "eased as far as the margin"
+        assert beside.clearance_ok(robot.joint_state().q, hand=False)[0]
 
 
 def test_pads_still_pressed_after_the_easing_tip_it_off_turned_upright_and_back():

@@ -69,7 +69,7 @@ class Leaving(Withdrawing):
             back = self.withdrawal_path(approach, checker, level=False)
         eased = np.zeros(3)
         if pressed:  # even if lowered they feel nothing: what leaned on a pad still leans
-            eased = self._slide_pads_off()
+            eased = self._slide_pads_off(checker)
             back = self.withdrawal_path(approach, checker, level=False)
         if back is None:
             T_up = T_above.copy()
@@ -96,7 +96,7 @@ class Leaving(Withdrawing):
             failure = self.run_withdrawal(back, guard=guard)
             if failure is None or "unexpected contact" not in failure.message:
                 return failure
-            self._slide_pads_off()
+            self._slide_pads_off(checker)
             again = self.withdrawal_path(approach, checker, level=False)
             if again is None:  # eased where no way back is clear: on along the first one
                 q = self.current_q()
@@ -125,11 +125,12 @@ class Leaving(Withdrawing):
         (`_slide_pads_off`), so that the hand can rise without it; where they still press
         then, tip it off them (`_tip_off`, clear of `checker`). Say whether they were
         pressed. Over the basket, a spray bottle wedged against a pad at 27 N was lifted 4
-        cm by the rising hand and flung out on the way to ready."""
+        cm by the rising hand and flung out on the way to ready. The easing goes only as far
+        as the arm keeps its clearance from `checker` (`_arm_keeps_clear`)."""
         if not self._pads_still_pressed():
             return False
         self._lower_open_hand(tcp_pose(self.current_q()))
-        self._slide_pads_off()
+        self._slide_pads_off(checker)
         if self._pads_still_pressed():
             self._tip_off(checker)
         return True
@@ -166,20 +167,22 @@ class Leaving(Withdrawing):
         b = self.settings.behaviour
         return peak_pad_force(self.robot, b.leave_settle, b.feel_period) > b.pads_clear
 
-    def _slide_pads_off(self) -> np.ndarray:
+    def _slide_pads_off(self, checker: CollisionChecker) -> np.ndarray:
         """Ease the open hand sideways off what its pads touched, and say how far it moved
         (3,) (m, `base`).
 
         Along the closing axis by `leave_shift`, one way and, where the pads still feel
         something there, the other, slowly and guarded at `leave_nudge` over what the pads
         bear: the gripper feels only the pads' summed force, not which pad, so the way into
-        the object is found by touch, and stopped before it pushes the object over."""
+        the object is found by touch, and stopped before it pushes the object over. Each way
+        only as far as the arm keeps its clearance from `checker` (`_arm_keeps_clear`)."""
         s, b = self.settings.motion, self.settings.behaviour
         start = tcp_pose(self.current_q())
         for sign in (1.0, -1.0):
             T = start.copy()
             T[:3, 3] += sign * b.leave_shift * start[:3, 1]
             path = cartesian_line(self.current_q(), T, s.cartesian_step / 5)
+            path = None if path is None else self._arm_keeps_clear(path, checker)
             if path is None:
                 continue
             aside = timed(path, s, tcp_speed=b.leave_speed)
@@ -209,3 +212,17 @@ class Leaving(Withdrawing):
         self.robot.sleep(b.leave_settle)  # the servos lag the trajectory's clock
         if met is not None:
             self.rise_straight(start, "rising off what the fingers met")
+
+    @staticmethod
+    def _arm_keeps_clear(path: np.ndarray, checker: CollisionChecker) -> np.ndarray | None:
+        """The part of `path` (N, 6) rad from its start along which the arm, the hand left
+        out (the open hand starts about what it let go of), keeps the clearance from
+        `checker` it starts with; None where that is no move. Eased 1 cm sideways over the
+        basket, the arm came within the margin of a sensor post, and no way left from
+        there. An arm that already touches something (no clearance kept) is not held."""
+        kept = checker.clearance_kept(path[0], hand=False)
+        if kept is None:
+            return path
+        blocked = np.flatnonzero(~checker.clearance_ok(path, hand=False, margin=kept))
+        clear = path[: blocked[0]] if len(blocked) else path
+        return clear if len(clear) >= 2 else None
