@@ -8,12 +8,12 @@ import mujoco
 from laserpick.robot.sim.model.geoms import PARTS_BY_NAME, SHELL_GEOM, add_shape
 from laserpick.robot.sim.model.names import SCOOTER_BODY
 
-#: The basket's contacts: stiffer than MuJoCo's default time constant (0.02 s), and the
-#: basket's in a contact with an object (`solmix` weighs the mix). A drop stops within the
-#: board: at the default, a 0.6 g pill let go 34-60 cm over the basket's floor went through
-#: its 3 cm board in 24 of 45 drops (the soft contact lets it sink 2-3 cm first); at 0.01 s in
-#: none, and where a mug, a spice jar, a pill bottle, a soda can, a remote and a phone land
-#: from the same drops is unchanged.
+#: The basket's contacts: a time constant stiffer than MuJoCo's default (0.02 s), and the
+#: basket's is the one a contact with an object takes (`solmix` weighs the mix). A drop then
+#: stops within the board: at the default, a 0.6 g pill let go 34-60 cm over the basket's
+#: floor went through its 3 cm board in 24 of 45 drops (the soft contact lets it sink 2-3 cm
+#: first); at 0.01 s in none, and where a mug, a spice jar, a pill bottle, a soda can, a
+#: remote and a phone land from the same drops is unchanged.
 BASKET_CONTACT = {"solref": [0.01, 1.0], "solmix": 1000.0}
 
 
