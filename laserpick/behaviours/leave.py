@@ -149,11 +149,8 @@ class Leaving(Withdrawing):
         upright = T.copy()
         upright[:3, :3] = turn_between(T[:3, 2], np.array([0.0, 0.0, -1.0])) @ T[:3, :3]
         turn = cartesian_line(start, upright, s.cartesian_step / 5)
+        turn = None if turn is None else _clear_start(turn, checker.clearance_ok(turn))
         if turn is None:
-            return
-        blocked = np.flatnonzero(~checker.clearance_ok(turn))
-        turn = turn[: blocked[0] if len(blocked) else len(turn)]
-        if len(turn) < 2:
             return
         guard = pad_force(self.robot) + s.place_contact_force
         for path in (turn, turn[::-1]):
@@ -223,6 +220,12 @@ class Leaving(Withdrawing):
         kept = checker.clearance_kept(path[0], hand=False)
         if kept is None:
             return path
-        blocked = np.flatnonzero(~checker.clearance_ok(path, hand=False, margin=kept))
-        clear = path[: blocked[0]] if len(blocked) else path
-        return clear if len(clear) >= 2 else None
+        return _clear_start(path, checker.clearance_ok(path, hand=False, margin=kept))
+
+
+def _clear_start(path: np.ndarray, clear: np.ndarray) -> np.ndarray | None:
+    """The part of `path` (N, 6) rad before its first configuration that `clear` (N,) marks
+    blocked; None where that is no move (fewer than two configurations)."""
+    blocked = np.flatnonzero(~clear)
+    start = path[: blocked[0]] if len(blocked) else path
+    return start if len(start) >= 2 else None
